@@ -1,0 +1,264 @@
+"""Hand model: fingertips moving on rays or elliptic arcs in the image plane (thesis 3.3).
+
+Frames
+------
+The *hand frame* is 2-D, in the image plane: its origin is the hand's reference
+point (x_p, y_p) of eq 3.18 and every finger's ``start`` (x_f, y_f) is given in
+it. A pose (x, y, yaw) places the hand frame in the camera's image plane (optical
+frame, x right, y down): ``p_image = (x, y) + R(yaw) p_hand`` with
+``R(yaw) = [[cos, -sin], [sin, cos]]``, a right-handed rotation about the
+camera's z axis. Eq 3.19 prints the transpose (a rotation by -yaw); the search
+covers every yaw, so only the sign of the reported yaw differs.
+
+Trajectories
+------------
+Every trajectory is parameterised by ``lam``, the distance travelled along it in
+meters, ``0 <= lam <= travel`` (F of eq 3.29):
+
+* :class:`Ray` (eq 3.18): ``start + lam * closing_direction``. The presets store
+  ``closing_direction = -m`` of the thesis tables, whose (m_x, m_y) point away
+  from the grasp (see the preset files).
+* :class:`Arc` (eq 3.20-3.21): ``start + E(phi_off + theta) - E(phi_off)`` with
+  ``E(a) = (a_cos cos a, a_sin sin a)`` and ``theta`` the angle whose arc length
+  on the ellipse is ``lam`` (the thesis's lambda is this angle; we keep travel a
+  distance so that F, D_min and lambda_virt mean the same for every finger).
+
+``virtual_start`` is lambda_virt: the virtual start point of the ratio cost
+(eq 3.35-3.37) is the trajectory at ``lam = virtual_start``; positive values lie
+ahead along the closing motion (a finger that closes early or fast).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+
+from . import tolerances as tol
+
+
+@dataclass(frozen=True)
+class Ray:
+    """Straight closing motion (eq 3.18); ``closing_direction`` is normalised on creation."""
+
+    closing_direction: tuple[float, float]
+
+    def __post_init__(self):
+        c = np.asarray(self.closing_direction, dtype=float)
+        norm = float(np.linalg.norm(c))
+        if c.shape != (2,) or not np.isfinite(norm) or norm < tol.MIN_DIRECTION:
+            raise ValueError(f"closing_direction must be a non-zero 2-vector, got {self.closing_direction!r}")
+        object.__setattr__(self, "closing_direction", (float(c[0] / norm), float(c[1] / norm)))
+
+
+@dataclass(frozen=True)
+class Arc:
+    """Elliptic-arc closing motion (eq 3.20-3.21): radii ``a_cos``, ``a_sin`` (m), start angle ``phi_off`` (rad)."""
+
+    a_cos: float
+    a_sin: float
+    phi_off: float
+
+    def __post_init__(self):
+        if not (self.a_cos > 0 and self.a_sin > 0):
+            raise ValueError(f"arc radii must be positive, got a_cos={self.a_cos}, a_sin={self.a_sin}")
+
+    @cached_property
+    def _length_table(self) -> tuple[np.ndarray, np.ndarray]:
+        theta = np.linspace(-2 * np.pi, 2 * np.pi, 2 * tol.ARC_LENGTH_TABLE + 1)
+        a = self.phi_off + theta
+        speed = np.hypot(self.a_cos * np.sin(a), self.a_sin * np.cos(a))
+        steps = 0.5 * (speed[1:] + speed[:-1]) * np.diff(theta)
+        s = np.concatenate([[0.0], np.cumsum(steps)])
+        return s - s[tol.ARC_LENGTH_TABLE], theta
+
+    @property
+    def perimeter(self) -> float:
+        s, _ = self._length_table
+        return float((s[-1] - s[0]) / 2)
+
+    def angle(self, lam) -> np.ndarray:
+        """Angle travelled on the ellipse after arc length ``lam`` (m); negative lam goes backwards."""
+        s, theta = self._length_table
+        return np.interp(lam, s, theta)
+
+    def offset(self, lam) -> np.ndarray:
+        """(m, 2) float: displacement from the start point after arc length ``lam`` (eq 3.20)."""
+        a = self.phi_off + self.angle(np.atleast_1d(lam))
+        return np.stack(
+            [self.a_cos * (np.cos(a) - np.cos(self.phi_off)), self.a_sin * (np.sin(a) - np.sin(self.phi_off))],
+            axis=-1,
+        )
+
+
+@dataclass(frozen=True)
+class Finger:
+    """One fingertip: where it starts, how it closes, and its gains (Tables 4.3, A.1, A.2).
+
+    Attributes
+    ----------
+    name : str
+    start : (2,) float
+        (x_f, y_f): fingertip of the open hand in the hand frame, m.
+    trajectory : Ray or Arc
+    travel : float
+        F: distance from open to fully closed along the trajectory, m.
+    virtual_start : float
+        lambda_virt, m (see module docstring).
+    alpha, beta : float
+        Gains on the curvature and ratio costs (eq 3.34).
+    required : bool
+        A pose is infeasible when this finger misses the object.
+    """
+
+    name: str
+    start: tuple[float, float]
+    trajectory: Ray | Arc
+    travel: float
+    virtual_start: float = 0.0
+    alpha: float = 1.0
+    beta: float = 0.0
+    required: bool = False
+
+    def __post_init__(self):
+        if not self.travel > 0:
+            raise ValueError(f"finger {self.name!r}: travel must be > 0, got {self.travel}")
+        if isinstance(self.trajectory, Arc) and max(self.travel, abs(self.virtual_start)) >= self.trajectory.perimeter:
+            raise ValueError(f"finger {self.name!r}: travel and virtual_start must be shorter than the arc's ellipse")
+        object.__setattr__(self, "start", (float(self.start[0]), float(self.start[1])))
+
+    def points(self, lam) -> np.ndarray:
+        """(m, 2) float: fingertip positions in the hand frame after travelling ``lam`` (m)."""
+        lam = np.atleast_1d(np.asarray(lam, dtype=float))
+        if isinstance(self.trajectory, Ray):
+            offset = lam[:, None] * np.asarray(self.trajectory.closing_direction)
+        else:
+            offset = self.trajectory.offset(lam)
+        return np.asarray(self.start) + offset
+
+    def polyline(self) -> tuple[np.ndarray, np.ndarray]:
+        """The trajectory as chords: vertices (k+1, 2) in the hand frame and their lam (k+1,)."""
+        chords = 1 if isinstance(self.trajectory, Ray) else tol.ARC_CHORDS
+        lam = np.linspace(0.0, self.travel, chords + 1)
+        return self.points(lam), lam
+
+    @property
+    def end(self) -> np.ndarray:
+        """(2,) float: fingertip of the fully closed hand."""
+        return self.points(self.travel)[0]
+
+    @property
+    def virtual_start_point(self) -> np.ndarray:
+        """(2,) float: p_virt of eq 3.37."""
+        return self.points(self.virtual_start)[0]
+
+
+@dataclass(frozen=True)
+class Hand:
+    """A hand: its fingers and the feasibility rules for missed fingers.
+
+    Attributes
+    ----------
+    name : str
+    fingers : tuple of Finger
+    min_touching : int
+        A pose is feasible only when at least this many fingers touch the object.
+    miss_penalty : float
+        Cost added per finger that closes on air (the ``miss`` part of the cost).
+    description : str
+    """
+
+    name: str
+    fingers: tuple[Finger, ...]
+    min_touching: int
+    miss_penalty: float = 250.0
+    description: str = field(default="", compare=False)
+
+    def __post_init__(self):
+        object.__setattr__(self, "fingers", tuple(self.fingers))
+        n = len(self.fingers)
+        if n == 0:
+            raise ValueError(f"hand {self.name!r} has no fingers")
+        if not 1 <= self.min_touching <= n:
+            raise ValueError(f"hand {self.name!r}: min_touching must be in 1..{n}, got {self.min_touching}")
+        if len({f.name for f in self.fingers}) != n:
+            raise ValueError(f"hand {self.name!r}: finger names must be unique")
+
+    @property
+    def starts(self) -> np.ndarray:
+        """(n_fingers, 2) float: open-hand fingertips, hand frame."""
+        return np.array([f.start for f in self.fingers])
+
+    @property
+    def ends(self) -> np.ndarray:
+        """(n_fingers, 2) float: closed-hand fingertips, hand frame."""
+        return np.array([f.end for f in self.fingers])
+
+    @property
+    def virtual_starts(self) -> np.ndarray:
+        """(n_fingers, 2) float: virtual start points p_virt, hand frame."""
+        return np.array([f.virtual_start_point for f in self.fingers])
+
+    @property
+    def grasp_centre(self) -> np.ndarray:
+        """(2,) float: mean of the fully closed fingertips, hand frame."""
+        return self.ends.mean(axis=0)
+
+    def segments(self) -> "HandSegments":
+        """All fingers' trajectory chords, stacked for vectorised intersection."""
+        starts, ends, finger, lam0 = [], [], [], []
+        for i, f in enumerate(self.fingers):
+            pts, lam = f.polyline()
+            starts.append(pts[:-1])
+            ends.append(pts[1:])
+            finger.append(np.full(len(lam) - 1, i))
+            lam0.append(lam[:-1])
+        return HandSegments(
+            start=np.vstack(starts), end=np.vstack(ends), finger=np.concatenate(finger), lam0=np.concatenate(lam0)
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class HandSegments:
+    """Trajectory chords of all fingers, hand frame.
+
+    Attributes
+    ----------
+    start, end : (s, 2) float
+    finger : (s,) int
+        Index of the finger each chord belongs to; chords of a finger are in closing order.
+    lam0 : (s,) float
+        Distance travelled at each chord's start, m.
+    """
+
+    start: np.ndarray
+    end: np.ndarray
+    finger: np.ndarray
+    lam0: np.ndarray
+
+    @property
+    def length(self) -> np.ndarray:
+        return np.linalg.norm(self.end - self.start, axis=1)
+
+
+def rotation(yaw) -> np.ndarray:
+    """(..., 2, 2) float: R(yaw) = [[cos, -sin], [sin, cos]], hand frame -> image plane."""
+    c, s = np.cos(yaw), np.sin(yaw)
+    return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)
+
+
+def to_image(points_hand, pose) -> np.ndarray:
+    """Hand-frame points placed at a pose (x, y, yaw) in the image plane.
+
+    Parameters
+    ----------
+    points_hand : (m, 2) float
+    pose : (3,) float
+
+    Returns
+    -------
+    (m, 2) float
+    """
+    x, y, yaw = pose
+    return np.asarray(points_hand, dtype=float) @ rotation(yaw).T + np.array([x, y])

@@ -1,0 +1,193 @@
+"""Hand description files (TOML) and the built-in presets.
+
+Schema (all lengths in meters, angles in radians)::
+
+    name = "my-hand"                 # required
+    description = "..."              # optional
+    min_touching = 4                 # required, 1..number of fingers
+    miss_penalty = 250.0             # optional, >= 0, cost per finger closing on air;
+                                     # default 10 x the largest alpha (about one finger's
+                                     # swing of paper-curvature cost, |C| <~ 5 m)
+
+    [[fingers]]                      # one table per finger, at least one
+    name = "thumb"
+    start = [-0.115, 0.1]            # (x_f, y_f), hand frame
+    closing_direction = [0.994, 0.106]   # a ray ...
+    # arc = { a_cos = 0.055, a_sin = 0.04, phi_off = 3.77 }   # ... or an elliptic arc
+    travel = 0.09                    # F > 0: distance (arc length for arcs)
+    virtual_start = 0.03             # lambda_virt, optional, default 0
+    alpha = 25.0                     # curvature gain, optional, default 1
+    beta = 10000.0                   # ratio gain, optional, default 0
+    required = true                  # optional, default false
+
+Unknown keys, wrong types and impossible values are refused with
+:class:`~contourgrasp.errors.HandFileError` naming the file and the field.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from importlib import resources
+from pathlib import Path
+from typing import Annotated
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from ..errors import HandFileError
+from ..hand import Arc, Finger, Hand, Ray
+
+_PRESET_DIR = "data/hands"
+
+#: Default miss_penalty per unit of the largest curvature gain alpha.
+MISS_PENALTY_PER_ALPHA = 10.0
+
+PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
+Vector2 = Annotated[list[FiniteFloat], Field(min_length=2, max_length=2)]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", strict=True, frozen=True)
+
+
+class _ArcSchema(_Strict):
+    a_cos: PositiveFloat
+    a_sin: PositiveFloat
+    phi_off: FiniteFloat
+
+
+class _FingerSchema(_Strict):
+    name: str = Field(min_length=1)
+    start: Vector2
+    closing_direction: Vector2 | None = None
+    arc: _ArcSchema | None = None
+    travel: PositiveFloat
+    virtual_start: FiniteFloat = 0.0
+    alpha: FiniteFloat = 1.0
+    beta: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.0
+    required: bool = False
+
+    @model_validator(mode="after")
+    def _one_trajectory(self):
+        if (self.closing_direction is None) == (self.arc is None):
+            raise ValueError("give exactly one of closing_direction (a ray) or arc")
+        if self.closing_direction is not None and max(map(abs, self.closing_direction)) == 0:
+            raise ValueError("closing_direction has zero length")
+        return self
+
+
+class _HandSchema(_Strict):
+    name: str = Field(min_length=1)
+    description: str = ""
+    min_touching: int = Field(ge=1)
+    miss_penalty: Annotated[float, Field(ge=0, allow_inf_nan=False)] | None = None
+    fingers: list[_FingerSchema] = Field(min_length=1)
+
+    @model_validator(mode="after")
+    def _consistent(self):
+        if self.min_touching > len(self.fingers):
+            raise ValueError(f"min_touching = {self.min_touching} exceeds the {len(self.fingers)} fingers")
+        names = [f.name for f in self.fingers]
+        if len(set(names)) != len(names):
+            raise ValueError(f"finger names must be unique, got {names}")
+        return self
+
+
+def preset_names() -> list[str]:
+    """Names of the built-in hands, sorted."""
+    folder = resources.files("contourgrasp").joinpath(_PRESET_DIR)
+    return sorted(p.name.removesuffix(".toml") for p in folder.iterdir() if p.name.endswith(".toml"))
+
+
+def load_hand(spec) -> Hand:
+    """A hand from a preset name, a TOML file path, or a :class:`Hand` (returned as is).
+
+    Examples
+    --------
+    >>> load_hand("three-finger").min_touching
+    3
+    """
+    if isinstance(spec, Hand):
+        return spec
+    spec = str(spec)
+    if spec in preset_names():
+        resource = resources.files("contourgrasp").joinpath(f"{_PRESET_DIR}/{spec}.toml")
+        return parse_hand(resource.read_text(encoding="utf-8"), source=f"preset {spec}")
+    path = Path(spec)
+    if not path.suffix and not path.exists():
+        raise HandFileError(f"unknown hand {spec!r}: not a preset ({', '.join(preset_names())}) nor a file")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as err:
+        raise HandFileError(f"{path}: cannot read hand file ({err.strerror or err})") from None
+    return parse_hand(text, source=str(path))
+
+
+def parse_hand(text: str, *, source: str = "<string>") -> Hand:
+    """Parse and validate the TOML text of a hand description; ``source`` names it in errors."""
+    try:
+        raw = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise HandFileError(f"{source}: not valid TOML ({err})") from None
+    try:
+        schema = _HandSchema.model_validate(raw)
+    except ValidationError as err:
+        raise HandFileError(f"{source}: {_describe(err, raw)}") from None
+    try:
+        fingers = tuple(_finger(f) for f in schema.fingers)
+    except ValueError as err:
+        raise HandFileError(f"{source}: {err}") from None
+    return Hand(
+        name=schema.name,
+        fingers=fingers,
+        min_touching=schema.min_touching,
+        miss_penalty=_miss_penalty(schema),
+        description=schema.description,
+    )
+
+
+def _miss_penalty(schema: _HandSchema) -> float:
+    if schema.miss_penalty is not None:
+        return schema.miss_penalty
+    return MISS_PENALTY_PER_ALPHA * max(abs(f.alpha) for f in schema.fingers)
+
+
+def _finger(f: _FingerSchema) -> Finger:
+    trajectory = Ray(tuple(f.closing_direction)) if f.arc is None else Arc(f.arc.a_cos, f.arc.a_sin, f.arc.phi_off)
+    return Finger(
+        name=f.name,
+        start=tuple(f.start),
+        trajectory=trajectory,
+        travel=f.travel,
+        virtual_start=f.virtual_start,
+        alpha=f.alpha,
+        beta=f.beta,
+        required=f.required,
+    )
+
+
+def _describe(err: ValidationError, raw: dict) -> str:
+    """The first validation error as 'fingers[0] (thumb).travel: message'."""
+    first = err.errors()[0]
+    parts = []
+    for key in first["loc"]:
+        if isinstance(key, int) and parts:
+            name = _finger_name(raw, key) if parts[-1] == "fingers" else None
+            parts[-1] += f"[{key}]" + (f" ({name})" if name else "")
+        else:
+            parts.append(str(key))
+    field = ".".join(parts) or "hand"
+    message = first["msg"]
+    if first["type"] == "extra_forbidden":
+        message = "unknown key"
+    elif first["type"] == "missing":
+        message = "required field is missing"
+    return f"{field}: {message.removeprefix('Value error, ')}"
+
+
+def _finger_name(raw: dict, index: int) -> str | None:
+    try:
+        name = raw["fingers"][index]["name"]
+    except (KeyError, IndexError, TypeError):
+        return None
+    return name if isinstance(name, str) else None

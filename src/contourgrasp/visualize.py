@@ -1,0 +1,106 @@
+"""Figures: the planned grasp (thesis Fig 4.8-4.10) and EFD harmonics (Fig 4.5).
+
+Figures are drawn in the image plane with y pointing down, as the camera sees
+them. Functions return matplotlib ``Figure`` objects built without pyplot, so
+nothing here touches global plotting state; save them with ``fig.savefig``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from matplotlib.collections import LineCollection
+from matplotlib.figure import Figure
+from mpl_toolkits.axes_grid1.anchored_artists import AnchoredSizeBar
+
+from . import efd as efd_model
+from .hand import to_image
+from .synthesis import GraspPlan
+
+CONVEX_COLOUR = "0.25"
+CONCAVE_COLOUR = "tab:blue"
+FINGER_COLOURS = ("tab:red", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink", "tab:olive")
+
+
+def draw_efd(ax, model: efd_model.EFD, *, curvature: str = "paper", samples: int = 720, linewidth: float = 2.0):
+    """Draw the EFD curve on ``ax`` with concave stretches coloured."""
+    t, points = efd_model.sample(model, samples)
+    concave = efd_model.concave(model, t, curvature)
+    closed = np.vstack([points, points[:1]])
+    segments = np.stack([closed[:-1], closed[1:]], axis=1)
+    colours = np.where(concave, CONCAVE_COLOUR, CONVEX_COLOUR)
+    ax.add_collection(LineCollection(segments, colors=colours, linewidths=linewidth))
+
+
+def draw_plan(ax, plan: GraspPlan) -> None:
+    """Draw a plan on ``ax``: polygon, EFD contour, finger trajectories, starts, virtual starts, grasp points."""
+    ax.plot(*np.vstack([plan.contour, plan.contour[:1]]).T, color="0.7", lw=1, label="input contour")
+    draw_efd(ax, plan.efd, curvature=plan.curvature_mode)
+    ax.plot([], [], color=CONVEX_COLOUR, lw=2, label="EFD convex")
+    ax.plot([], [], color=CONCAVE_COLOUR, lw=2, label="EFD concave")
+    pose = plan.pose
+    for i, (finger, contact) in enumerate(zip(plan.hand.fingers, plan.fingers)):
+        colour = FINGER_COLOURS[i % len(FINGER_COLOURS)]
+        reach = finger.travel if contact.missed else contact.lam
+        travelled = to_image(finger.points(np.linspace(0, reach, 50)), pose)
+        rest = to_image(finger.points(np.linspace(reach, finger.travel, 20)), pose)
+        ax.plot(*travelled.T, color=colour, lw=1.8, ls="--" if contact.missed else "-")
+        ax.plot(*rest.T, color=colour, lw=1, alpha=0.3)
+        ax.plot(*contact.start, "o", color=colour, ms=6, mfc="white")
+        ax.plot(*contact.virtual_start, "x", color=colour, ms=6)
+        marker = "X" if contact.missed else "*"
+        ax.plot(*contact.grasp_point, marker, color=colour, ms=13, mec="black", mew=0.6)
+        label = finger.name + (" (missed)" if contact.missed else "")
+        ax.annotate(label, contact.start, textcoords="offset points", xytext=(5, 5), color=colour, fontsize=9)
+    ax.plot(*pose[:2], "s", color="black", ms=6)
+    heading = to_image(np.array([[0.0, 0.0], [0.03, 0.0]]), pose)
+    ax.annotate("", heading[1], heading[0], arrowprops={"arrowstyle": "->", "color": "black"})
+    ax.plot([], [], "o", color="0.3", mfc="white", label="start")
+    ax.plot([], [], "x", color="0.3", label="virtual start")
+    ax.plot([], [], "*", color="0.3", ms=10, label="grasp point")
+    ax.plot([], [], "s", color="black", label="hand pose (x, y, yaw)")
+
+
+def _finish_axes(ax, scale: float = 0.05) -> None:
+    ax.set_aspect("equal")
+    ax.autoscale_view()
+    if not ax.yaxis_inverted():
+        ax.invert_yaxis()
+    ax.set_xlabel("x [m] (image right)")
+    ax.set_ylabel("y [m] (image down)")
+    ax.add_artist(AnchoredSizeBar(ax.transData, scale, f"{scale * 100:.0f} cm", "lower right", frameon=False, size_vertical=scale / 40))
+    ax.grid(alpha=0.3)
+
+
+def plan_figure(plan: GraspPlan) -> Figure:
+    """The thesis's Figure 4.8-4.10 picture of a plan, with its cost in the title."""
+    fig = Figure(figsize=(9.5, 7.0), layout="constrained")
+    ax = fig.add_subplot()
+    draw_plan(ax, plan)
+    _finish_axes(ax)
+    x, y, yaw = plan.pose
+    c = plan.cost
+    ax.set_title(
+        f"{plan.hand.name}: pose x={x:.3f} m, y={y:.3f} m, yaw={np.degrees(yaw):.0f}°\n"
+        f"cost {c.total:.1f} = curvature {c.curvature:.1f} + ratio {c.ratio:.1f} + miss {c.miss:.0f}"
+        f"  ({plan.curvature_mode} curvature, {plan.efd.harmonics} harmonics)",
+        fontsize=10,
+    )
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    return fig
+
+
+def harmonics_figure(contour_xy, harmonics: Sequence[int] = (1, 2, 4, 8), *, curvature: str = "paper") -> Figure:
+    """The thesis's Figure 4.5: one contour approximated with several harmonic counts."""
+    contour = efd_model.clean_polygon(contour_xy, check_units=False)
+    fig = Figure(figsize=(3.2 * len(harmonics), 3.6), layout="constrained")
+    axes = fig.subplots(1, len(harmonics), sharex=True, sharey=True, squeeze=False)[0]
+    for ax, k in zip(axes, harmonics):
+        model = efd_model.fit(contour, k)
+        ax.plot(*np.vstack([contour, contour[:1]]).T, color="0.7", lw=1)
+        draw_efd(ax, model, curvature=curvature)
+        ax.set_title(f"{k} harmonic{'s' if k > 1 else ''}")
+        _finish_axes(ax, scale=0.02)
+    fig.suptitle(f"EFD approximation; concave stretches in blue ({curvature} curvature)", fontsize=10)
+    return fig

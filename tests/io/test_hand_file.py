@@ -1,0 +1,81 @@
+import math
+
+import pytest
+
+import contourgrasp as cg
+from contourgrasp import HandFileError
+from contourgrasp.io.hand_file import load_hand, parse_hand
+
+GOOD = """
+name = "pinch"
+min_touching = 2
+[[fingers]]
+name = "left"
+start = [-0.06, 0.0]
+closing_direction = [1.0, 0.0]
+travel = 0.05
+alpha = 10.0
+beta = 1000.0
+[[fingers]]
+name = "right"
+start = [0.06, 0.0]
+closing_direction = [-1.0, 0.0]
+travel = 0.05
+alpha = 10.0
+beta = 1000.0
+"""
+
+
+def test_a_hand_file_plans_grasps(tmp_path):
+    path = tmp_path / "pinch.toml"
+    path.write_text(GOOD)
+    hand = load_hand(path)
+    assert hand.name == "pinch" and [f.name for f in hand.fingers] == ["left", "right"]
+    assert hand.miss_penalty == pytest.approx(100.0)  # 10 x the largest alpha
+    plan = cg.synthesize(cg.example_contour("ellipse") * 0.8, path, yaw_step=math.radians(10))
+    assert not any(f.missed for f in plan.fingers)
+
+
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (("travel = 0.05", "travel = 0.0", 1), r"fingers\[0\] \(left\)\.travel: Input should be greater than 0"),
+        (("closing_direction = [1.0, 0.0]", "closing_direction = [0.0, 0.0]", 1), r"fingers\[0\] \(left\): closing_direction has zero length"),
+        (("alpha = 10.0", "alpha = 10.0\ncolour = 3", 1), r"fingers\[0\] \(left\)\.colour: unknown key"),
+        (("travel = 0.05", 'travel = "far"', 1), r"travel: Input should be a valid number"),
+        (("min_touching = 2", "min_touching = 3", 1), r"min_touching = 3 exceeds the 2 fingers"),
+        (('name = "pinch"\n', "", 1), r"name: required field is missing"),
+        (("start = [-0.06, 0.0]", "start = [-0.06]", 1), r"start: List should have at least 2 items"),
+        (("closing_direction = [1.0, 0.0]", "closing_direction = [1.0, 0.0]\narc = {a_cos = 0.05, a_sin = 0.04, phi_off = 0.0}", 1), "exactly one of"),
+        (("beta = 1000.0", "beta = -1.0", 1), r"beta: Input should be greater than or equal to 0"),
+        (("[[fingers]]", "[[fingers", 1), "not valid TOML"),
+    ],
+)
+def test_hand_file_errors_name_the_file_and_the_field(tmp_path, edit, message):
+    old, new, count = edit
+    path = tmp_path / "bad.toml"
+    path.write_text(GOOD.replace(old, new, count))
+    with pytest.raises(HandFileError, match=rf"^{path}: .*{message}"):
+        load_hand(path)
+
+
+def test_unknown_hand_and_missing_file():
+    with pytest.raises(HandFileError, match="unknown hand 'six-finger'"):
+        load_hand("six-finger")
+    with pytest.raises(HandFileError, match="cannot read hand file"):
+        load_hand("/nonexistent/hand.toml")
+
+
+def test_parse_hand_source_name():
+    with pytest.raises(HandFileError, match="^mine: "):
+        parse_hand("name = 3", source="mine")
+
+
+def test_presets_have_the_table_values():
+    hand = load_hand("five-finger-linear")
+    thumb = hand.fingers[0]
+    assert thumb.trajectory.closing_direction == pytest.approx((0.994, 0.106), abs=1e-3)
+    assert (thumb.travel, thumb.virtual_start, thumb.alpha, thumb.beta, thumb.required) == (0.09, 0.03, 25.0, 1e4, True)
+    assert [f.virtual_start for f in hand.fingers] == [0.03, 0.0, 0.0, 0.01, 0.01]
+    three = load_hand("three-finger")
+    assert [f.beta for f in three.fingers] == [5e4] * 3 and three.min_touching == 3

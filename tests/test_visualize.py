@@ -1,0 +1,28 @@
+import math
+
+import numpy as np
+
+import contourgrasp as cg
+from contourgrasp import visualize
+
+
+def test_plan_figure_draws_every_finger_and_the_cost():
+    plan = cg.synthesize(cg.example_contour("can"), "five-finger-linear", yaw_step=math.radians(6))
+    fig = visualize.plan_figure(plan)
+    ax = fig.axes[0]
+    labels = [t.get_text() for t in ax.texts]
+    for finger in plan.hand.fingers:
+        assert any(label.startswith(finger.name) for label in labels)
+    assert f"{plan.cost.total:.1f}" in ax.get_title()
+    assert ax.yaxis_inverted()
+    grasp_markers = [line for line in ax.lines if line.get_marker() in ("*", "X") and len(line.get_xdata()) == 1]
+    assert len(grasp_markers) == len(plan.fingers)
+    for line, contact in zip(grasp_markers, plan.fingers):
+        np.testing.assert_allclose([line.get_xdata()[0], line.get_ydata()[0]], contact.grasp_point)
+
+
+def test_harmonics_figure_has_one_panel_per_count(tmp_path):
+    fig = visualize.harmonics_figure(cg.example_contour("stone2"), (1, 4, 8))
+    assert [ax.get_title() for ax in fig.axes] == ["1 harmonic", "4 harmonics", "8 harmonics"]
+    fig.savefig(tmp_path / "h.png")
+    assert (tmp_path / "h.png").stat().st_size > 1000
