@@ -91,6 +91,12 @@ class Arc:
             axis=-1,
         )
 
+    def tangent(self, lam) -> np.ndarray:
+        """(m, 2) float: unit direction of motion after arc length ``lam`` (m)."""
+        a = self.phi_off + self.angle(np.atleast_1d(lam))
+        d = np.stack([-self.a_cos * np.sin(a), self.a_sin * np.cos(a)], axis=-1)
+        return d / np.linalg.norm(d, axis=-1, keepdims=True)
+
 
 @dataclass(frozen=True)
 class Finger:
@@ -136,6 +142,13 @@ class Finger:
         else:
             offset = self.trajectory.offset(lam)
         return np.asarray(self.start) + offset
+
+    def tangent(self, lam) -> np.ndarray:
+        """(m, 2) float: unit direction of motion d points / d lam, hand frame."""
+        lam = np.atleast_1d(np.asarray(lam, dtype=float))
+        if isinstance(self.trajectory, Ray):
+            return np.tile(np.asarray(self.trajectory.closing_direction), (len(lam), 1))
+        return self.trajectory.tangent(lam)
 
     def polyline(self) -> tuple[np.ndarray, np.ndarray]:
         """The trajectory as chords: vertices (k+1, 2) in the hand frame and their lam (k+1,)."""

@@ -21,7 +21,7 @@ COLLINEAR = 1e-12
 EFD_SAMPLES = 256
 
 #: Number of chords an elliptic-arc finger trajectory is split into.
-ARC_CHORDS = 8
+ARC_CHORDS = 16
 
 #: Samples of the ellipse used to turn arc length into angle.
 ARC_LENGTH_TABLE = 4096
@@ -31,6 +31,12 @@ PARALLEL = 1e-15
 
 #: Length of a closing direction below which it has no direction.
 MIN_DIRECTION = 1e-9
+
+#: Samples of the curvature table used while screening the grid.
+CURVATURE_TABLE = 4096
+
+#: Screened poses re-evaluated exactly (at least; 8 x top_k if more).
+REFINE_CANDIDATES = 64
 
 #: Poses evaluated at once; bounds the memory of the (poses, segments, edges) arrays.
 POSE_CHUNK = 256
