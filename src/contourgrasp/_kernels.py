@@ -22,29 +22,29 @@ BUCKETS = 64
 
 
 @njit(cache=True)
-def _buckets(lateral, n_buckets):
-    """CSR lists of the edges whose lateral extent overlaps each bucket."""
+def _buckets(lateral, span, offsets, members):
+    """Fill CSR lists (offsets (BUCKETS + 1,), members) of the edges overlapping each lateral bucket.
+
+    ``span`` (m, 2) int is scratch space. Returns the lowest lateral offset and the bucket width.
+    """
     m = lateral.shape[0]
     lo_all, hi_all = lateral.min(), lateral.max()
-    width = (hi_all - lo_all) / n_buckets + 1e-15
-    first = np.empty(m, np.int64)
-    last = np.empty(m, np.int64)
-    counts = np.zeros(n_buckets + 1, np.int64)
+    width = (hi_all - lo_all) / BUCKETS + 1e-15
+    offsets[:] = 0
     for k in range(m):
         a, b = lateral[k], lateral[(k + 1) % m]
-        lo, hi = min(a, b), max(a, b)
-        first[k] = min(int((lo - lo_all) / width), n_buckets - 1)
-        last[k] = min(int((hi - lo_all) / width), n_buckets - 1)
-        for j in range(first[k], last[k] + 1):
-            counts[j + 1] += 1
-    offsets = np.cumsum(counts)
+        span[k, 0] = min(int((min(a, b) - lo_all) / width), BUCKETS - 1)
+        span[k, 1] = min(int((max(a, b) - lo_all) / width), BUCKETS - 1)
+        for j in range(span[k, 0], span[k, 1] + 1):
+            offsets[j + 1] += 1
+    for j in range(BUCKETS):
+        offsets[j + 1] += offsets[j]
     fill = offsets[:-1].copy()
-    members = np.empty(offsets[-1], np.int64)
     for k in range(m):
-        for j in range(first[k], last[k] + 1):
+        for j in range(span[k, 0], span[k, 1] + 1):
             members[fill[j]] = k
             fill[j] += 1
-    return lo_all, width, offsets, members
+    return lo_all, width
 
 
 @njit(cache=True)
@@ -100,6 +100,9 @@ def grid_first_touch(q, q_t, period, curvature_table, xs, ys, yaws, seg_start, s
         e[k, 0] = q[(k + 1) % m, 0] - q[k, 0]
         e[k, 1] = q[(k + 1) % m, 1] - q[k, 1]
     lateral = np.empty(m)
+    span = np.empty((m, 2), np.int64)
+    offsets = np.empty(BUCKETS + 1, np.int64)
+    members = np.empty(m * BUCKETS, np.int64)
     for iyaw in range(nyaw):
         c, s = math.cos(yaws[iyaw]), math.sin(yaws[iyaw])
         for sg in range(seg_start.shape[0]):
@@ -111,7 +114,7 @@ def grid_first_touch(q, q_t, period, curvature_table, xs, ys, yaws, seg_start, s
             nxl, nyl = -dy / length, dx / length
             for k in range(m):
                 lateral[k] = q[k, 0] * nxl + q[k, 1] * nyl
-            lo, width, offsets, members = _buckets(lateral, BUCKETS)
+            lo, width = _buckets(lateral, span, offsets, members)
             f = seg_finger[sg]
             for ix in range(nx):
                 px = xs[ix] + ox

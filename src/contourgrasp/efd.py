@@ -181,7 +181,7 @@ def first_self_intersection(points: np.ndarray) -> tuple[int, int] | None:
     return int(i[keep][hits[0]]), int(j[keep][hits[0]])
 
 
-def fit(points, harmonics: int = 4) -> EFD:
+def fit(points, harmonics: int = 4, *, validate: bool = True) -> EFD:
     """Fit the EFD model of a closed polygon (eq 3.9-3.17).
 
     Parameters
@@ -191,6 +191,8 @@ def fit(points, harmonics: int = 4) -> EFD:
         checked by :func:`clean_polygon` (call it first for the unit warning).
     harmonics : int
         Number of harmonics k (thesis default 4).
+    validate : bool
+        Run :func:`clean_polygon` on ``points``; pass False only for its output.
 
     Returns
     -------
@@ -209,7 +211,7 @@ def fit(points, harmonics: int = 4) -> EFD:
     """
     if not isinstance(harmonics, (int, np.integer)) or harmonics < 1:
         raise ContourError(f"harmonics must be a positive integer, got {harmonics!r}")
-    pts = clean_polygon(points, check_units=False)
+    pts = clean_polygon(points, check_units=False) if validate else np.asarray(points, dtype=float)
     if signed_area(pts) < 0:
         pts = np.concatenate([pts[:1], pts[:0:-1]])
     coefficients = pyefd.elliptic_fourier_descriptors(pts, order=int(harmonics), normalize=False)

@@ -521,13 +521,13 @@ def synthesize(
 
     clock = time.perf_counter()
     contour = efd_model.clean_polygon(contour_xy)
-    model = efd_model.fit(contour, harmonics)
+    model = efd_model.fit(contour, harmonics, validate=False)
     fitted = time.perf_counter()
     screen = screen_grid(model, hand, grid, curvature=curvature)
     searched = time.perf_counter()
     if not screen.feasible.any():
         raise NoFeasibleGrasp(_diagnose(screen, hand, grid))
-    result = _reevaluate_best(model, hand, screen, max(tol.REFINE_CANDIDATES, 8 * top_k), curvature, grid.d_min)
+    result = _reevaluate_best(model, hand, screen, max(tol.REFINE_CANDIDATES, 4 * top_k), curvature, grid.d_min)
     ranked = _distinct_best(result, grid, top_k)
     best = ranked[0]
     fingers = _contacts(model, hand, result, best, curvature)

@@ -35,8 +35,8 @@ MIN_DIRECTION = 1e-9
 #: Samples of the curvature table used while screening the grid.
 CURVATURE_TABLE = 4096
 
-#: Screened poses re-evaluated exactly (at least; 8 x top_k if more).
-REFINE_CANDIDATES = 64
+#: Screened poses re-evaluated exactly (at least; 4 x top_k if more).
+REFINE_CANDIDATES = 32
 
 #: Poses evaluated at once; bounds the memory of the (poses, segments, edges) arrays.
 POSE_CHUNK = 256

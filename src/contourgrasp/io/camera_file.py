@@ -1,0 +1,362 @@
+"""Camera files: colour and depth images, masks, intrinsics and extrinsics.
+
+Formats read
+------------
+Colour
+    Anything OpenCV reads (PNG, JPG, ...); returned in RGB order, uint8.
+Depth
+    ``.npy`` float: meters, as is. ``.npy`` integer, 16-bit ``.png``: raw
+    units times ``depth_scale`` (default 0.001, millimetres, as most
+    RGB-D drivers write). Float ``.tif``/``.tiff``: meters. A trailing
+    channel of 1 ((H, W, 1), as in the gqcnn files) is squeezed. 0 and NaN
+    mean "no reading" and are kept.
+Mask
+    Any image or ``.npy``; non-zero pixels (in any channel) are object.
+Intrinsics (JSON ``.json``/``.intr``, or YAML ``.yaml``/``.yml``)
+    * plain: ``{fx, fy, cx, cy, width, height}``;
+    * ROS camera_info: ``camera_matrix: {data: [9 numbers]}`` with
+      ``image_width``/``image_height`` (calibration YAML), or ``K``/``k`` (9
+      numbers) with ``width``/``height`` (CameraInfo message);
+    * BerkeleyAutomation ``.intr``: ``{_fx, _fy, _cx, _cy, _width, _height}``.
+Extrinsics: T_base_camera, the 4 x 4 rigid transform taking camera-frame points to the base frame
+    ``.npy`` or ``.txt`` (4 x 4 numbers); JSON/YAML holding a 4 x 4 list, or a
+    mapping with ``matrix`` (4 x 4) or ``rotation`` (3 x 3) and ``translation``
+    (3); autolab ``.tf`` (line 1 from-frame, line 2 to-frame, line 3
+    translation, lines 4-6 rotation rows; camera to world).
+
+Every problem is an :class:`~contourgrasp.errors.InputError` whose one-line
+message names the file (and the field).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from ..errors import InputError, UnitWarning
+from ..perception import Intrinsics
+
+#: Default raw-unit size of integer depth images, m (millimetres).
+DEPTH_SCALE = 0.001
+
+#: A median depth above this (m) is almost certainly not in meters.
+MAX_PLAUSIBLE_DEPTH = 20.0
+
+#: A median depth below this (m) is closer than any depth camera measures.
+MIN_PLAUSIBLE_DEPTH = 0.02
+
+#: Largest deviation of R^T R from I, and of det R from 1, accepted in an extrinsics file.
+#: 1e-5 rather than 1e-6: a rotation printed with 6 decimals, as in the autolab
+#: ``.tf`` files, is off by up to about 1.5e-6 (the shared primesense.tf by 1.02e-6).
+ROTATION_TOLERANCE = 1e-5
+
+__all__ = [
+    "DEPTH_SCALE", "Intrinsics", "RGBDFrame", "read_depth", "read_extrinsics", "read_intrinsics", "read_mask",
+    "read_rgb", "read_rgbd",
+]
+
+
+@dataclass(frozen=True, eq=False)
+class RGBDFrame:
+    """One frame: the images that were given, checked to have the intrinsics' size.
+
+    Attributes
+    ----------
+    rgb : (H, W, 3) uint8 or None
+        Colour, RGB order.
+    depth : (H, W) float or None
+        Depth in meters, 0 or NaN where missing.
+    intrinsics : Intrinsics or None
+    """
+
+    rgb: np.ndarray | None
+    depth: np.ndarray | None
+    intrinsics: Intrinsics | None
+
+
+def read_rgb(path) -> np.ndarray:
+    """(H, W, 3) uint8: a colour image in RGB order (grayscale files are expanded)."""
+    image = _read_image(path, cv2.IMREAD_COLOR)
+    return cv2.cvtColor(image, cv2.COLOR_BGR2RGB)
+
+
+def read_mask(path) -> np.ndarray:
+    """(H, W) bool: a mask image or ``.npy``; non-zero in any channel is object."""
+    path = Path(path)
+    data = _load_npy(path) if path.suffix.lower() == ".npy" else _read_image(path, cv2.IMREAD_UNCHANGED)
+    if data.ndim == 3:
+        data = np.any(data != 0, axis=2)
+    if data.ndim != 2:
+        raise InputError(f"{path}: a mask must be a 2-D image, got shape {data.shape}")
+    return np.nan_to_num(data.astype(float)) != 0
+
+
+def read_depth(path, *, depth_scale: float = DEPTH_SCALE) -> np.ndarray:
+    """Read a depth image in meters.
+
+    Parameters
+    ----------
+    path : str or Path
+        ``.npy``, 16-bit ``.png`` or float ``.tif``/``.tiff`` (module docstring).
+    depth_scale : float
+        Meters per raw unit of integer images.
+
+    Returns
+    -------
+    (H, W) float
+        Meters; 0 or NaN where there is no reading.
+
+    Raises
+    ------
+    InputError
+        Missing or unreadable file, wrong shape or type, no valid pixel.
+
+    Warns
+    -----
+    UnitWarning
+        When the median reading is implausible in meters (e.g. millimetres).
+    """
+    path = Path(path)
+    if isinstance(depth_scale, bool) or not isinstance(depth_scale, (int, float)) or not 0 < depth_scale < math.inf:
+        raise InputError(f"depth_scale must be a positive number, got {depth_scale!r}")
+    raw = _load_npy(path) if path.suffix.lower() == ".npy" else _read_image(path, cv2.IMREAD_UNCHANGED)
+    if raw.ndim == 3 and raw.shape[2] == 1:
+        raw = raw[..., 0]
+    if raw.ndim != 2:
+        raise InputError(f"{path}: depth must be one channel (H, W) or (H, W, 1), got shape {raw.shape}")
+    if np.issubdtype(raw.dtype, np.floating):
+        depth = raw.astype(float)
+    elif np.issubdtype(raw.dtype, np.integer) and raw.dtype.itemsize >= 2:
+        depth = raw.astype(float) * depth_scale
+    else:
+        raise InputError(f"{path}: depth of type {raw.dtype} (need float meters, or 16-bit or wider integers)")
+    present = depth[np.isfinite(depth) & (depth > 0)]
+    if present.size == 0:
+        raise InputError(f"{path}: depth has no valid pixel (all zero, negative or NaN)")
+    _check_depth_unit(path, float(np.median(present)), np.issubdtype(raw.dtype, np.integer))
+    return depth
+
+
+def _check_depth_unit(path, median, scaled):
+    hint = "check depth_scale" if scaled else "pass integer millimetres with depth_scale=0.001, or convert to meters"
+    if median > MAX_PLAUSIBLE_DEPTH:
+        unit = "millimetres (scale 0.001)" if median < 20_000 else "tenths of millimetres or finer (scale 0.0001)"
+        message = f"median depth {median:.4g} m: probably {unit}; {hint}"
+    elif median < MIN_PLAUSIBLE_DEPTH:
+        message = f"median depth {median:.4g} m is closer than a depth camera measures: already scaled twice? {hint}"
+    else:
+        return
+    warnings.warn(f"{path}: {message}", UnitWarning, stacklevel=3)
+
+
+def read_intrinsics(path) -> Intrinsics:
+    """Read camera intrinsics (plain, ROS camera_info, or BerkeleyAutomation ``.intr``; module docstring)."""
+    path = Path(path)
+    data = _read_mapping(path)
+    if not isinstance(data, dict):
+        raise InputError(f"{path}: intrinsics must be a mapping of fields, got {type(data).__name__}")
+    if "_fx" in data:
+        fields = {name: _field(path, data, f"_{name}") for name in ("fx", "fy", "cx", "cy", "width", "height")}
+    elif any(key in data for key in ("camera_matrix", "K", "k")):
+        fields = _ros_fields(path, data)
+    else:
+        fields = {name: _field(path, data, name) for name in ("fx", "fy", "cx", "cy", "width", "height")}
+    try:
+        return Intrinsics(**fields)
+    except InputError as err:
+        raise InputError(f"{path}: {err}") from None
+
+
+def _ros_fields(path, data) -> dict:
+    if "camera_matrix" in data:
+        matrix = _field(path, data, "camera_matrix")
+        if not isinstance(matrix, dict):
+            raise InputError(f"{path}: field camera_matrix must be a mapping with data: [9 numbers]")
+        k, k_name = _field(path, matrix, "data", "camera_matrix.data"), "camera_matrix.data"
+        width, height = _field(path, data, "image_width"), _field(path, data, "image_height")
+    else:
+        k_name = "K" if "K" in data else "k"
+        k = data[k_name]
+        width, height = _field(path, data, "width"), _field(path, data, "height")
+    k = _numbers(path, k, k_name, (9,))
+    return {"fx": k[0], "fy": k[4], "cx": k[2], "cy": k[5], "width": width, "height": height}
+
+
+def read_extrinsics(path) -> np.ndarray:
+    """Read T_base_camera, a 4 x 4 rigid transform (formats in the module docstring).
+
+    Returns
+    -------
+    (4, 4) float
+        p_base = T @ [p_camera, 1]. The rotation is re-orthonormalised (nearest
+        rotation), so it is exact even when the file rounded it.
+
+    Raises
+    ------
+    InputError
+        Unreadable file, wrong shape, or not rigid: R^T R or det R off by more
+        than ``ROTATION_TOLERANCE``, or a last row other than 0 0 0 1.
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".tf":
+        matrix = _read_tf(path)
+    elif suffix == ".npy":
+        matrix = _numbers(path, _load_npy(path), "matrix", (4, 4))
+    elif suffix == ".txt":
+        matrix = _numbers(path, _read_text(path).split(), "matrix", (16,)).reshape(4, 4)
+    else:
+        matrix = _mapping_transform(path, _read_mapping(path))
+    return _check_rigid(path, matrix)
+
+
+def _read_tf(path) -> np.ndarray:
+    lines = [line for line in _read_text(path).splitlines() if line.strip()]
+    if len(lines) != 6:
+        raise InputError(
+            f"{path}: a .tf file has 6 lines (from-frame, to-frame, translation, 3 rotation rows), got {len(lines)}"
+        )
+    translation = _numbers(path, lines[2].split(), "translation (line 3)", (3,))
+    rotation = _numbers(path, " ".join(lines[3:]).split(), "rotation (lines 4-6)", (9,)).reshape(3, 3)
+    return _homogeneous(rotation, translation)
+
+
+def _mapping_transform(path, data) -> np.ndarray:
+    if isinstance(data, list):
+        return _numbers(path, data, "matrix", (4, 4))
+    if not isinstance(data, dict):
+        raise InputError(f"{path}: expected a 4 x 4 list or a mapping, got {type(data).__name__}")
+    if "matrix" in data:
+        return _numbers(path, data["matrix"], "matrix", (4, 4))
+    if "rotation" in data or "translation" in data:
+        rotation = _numbers(path, _field(path, data, "rotation"), "rotation", (3, 3))
+        translation = _numbers(path, _field(path, data, "translation"), "translation", (3,))
+        return _homogeneous(rotation, translation)
+    raise InputError(f"{path}: missing field matrix (or rotation and translation)")
+
+
+def _homogeneous(rotation, translation) -> np.ndarray:
+    matrix = np.eye(4)
+    matrix[:3, :3], matrix[:3, 3] = rotation, translation
+    return matrix
+
+
+def _check_rigid(path, matrix) -> np.ndarray:
+    if np.abs(matrix[3] - [0.0, 0.0, 0.0, 1.0]).max() > 1e-9:
+        raise InputError(f"{path}: the last row of a rigid transform must be 0 0 0 1, got {matrix[3].tolist()}")
+    rotation = matrix[:3, :3]
+    error = float(np.abs(rotation.T @ rotation - np.eye(3)).max())
+    det = float(np.linalg.det(rotation))
+    if error > ROTATION_TOLERANCE or abs(det - 1) > ROTATION_TOLERANCE:
+        raise InputError(
+            f"{path}: the rotation is not orthonormal with det +1 (|R^T R - I| = {error:.2e}, det = {det:.6f}; "
+            f"tolerance {ROTATION_TOLERANCE:g})"
+        )
+    u, _, vt = np.linalg.svd(rotation)
+    out = matrix.copy()
+    out[:3, :3] = u @ vt
+    return out
+
+
+def read_rgbd(rgb_path=None, depth_path=None, intrinsics_path=None, *, depth_scale: float = DEPTH_SCALE) -> RGBDFrame:
+    """Read the files of one frame and check their sizes agree.
+
+    Any of the three may be None; depth needs intrinsics.
+
+    Raises
+    ------
+    InputError
+        From the readers, depth without intrinsics, or two sizes that differ
+        (the message gives both files and both sizes).
+    """
+    if depth_path is not None and intrinsics_path is None:
+        raise InputError(f"{depth_path}: a depth image needs an intrinsics file")
+    rgb = None if rgb_path is None else read_rgb(rgb_path)
+    depth = None if depth_path is None else read_depth(depth_path, depth_scale=depth_scale)
+    intrinsics = None if intrinsics_path is None else read_intrinsics(intrinsics_path)
+    sized = [(p, a.shape) for p, a in ((rgb_path, rgb), (depth_path, depth)) if a is not None]
+    if intrinsics is not None:
+        sized.append((intrinsics_path, intrinsics.shape))
+    for (path_a, shape_a), (path_b, shape_b) in zip(sized, sized[1:]):
+        if shape_a[:2] != shape_b[:2]:
+            raise InputError(
+                f"{path_a} is {shape_a[1]}x{shape_a[0]} but {path_b} is {shape_b[1]}x{shape_b[0]} (width x height)"
+            )
+    return RGBDFrame(rgb=rgb, depth=depth, intrinsics=intrinsics)
+
+
+# ---------------------------------------------------------------------------
+# Low-level readers
+# ---------------------------------------------------------------------------
+
+
+def _require_file(path: Path) -> None:
+    if not path.is_file():
+        raise InputError(f"{path}: file not found")
+
+
+def _read_image(path, flags) -> np.ndarray:
+    path = Path(path)
+    _require_file(path)
+    image = cv2.imread(str(path), flags)
+    if image is None:
+        raise InputError(f"{path}: not a readable image (PNG, JPG, TIFF, ...)")
+    return image
+
+
+def _load_npy(path: Path) -> np.ndarray:
+    _require_file(path)
+    try:
+        data = np.load(path, allow_pickle=False)
+    except (OSError, ValueError, EOFError) as err:
+        raise InputError(f"{path}: not a readable .npy array ({err})") from None
+    if not isinstance(data, np.ndarray) or not (data.dtype == bool or np.issubdtype(data.dtype, np.number)):
+        raise InputError(f"{path}: expected a numeric array")
+    return data
+
+
+def _read_text(path: Path) -> str:
+    _require_file(path)
+    try:
+        return path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as err:
+        raise InputError(f"{path}: cannot read file ({err})") from None
+
+
+def _read_mapping(path: Path):
+    text = _read_text(path)
+    if path.suffix.lower() in (".yaml", ".yml"):
+        import yaml  # optional dependency: only YAML files need it
+
+        try:
+            return yaml.safe_load(text)
+        except yaml.YAMLError as err:
+            raise InputError(f"{path}: not valid YAML ({' '.join(str(err).split())})") from None
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as err:
+        raise InputError(f"{path}: not valid JSON ({err})") from None
+
+
+def _field(path, data: dict, key: str, name: str | None = None):
+    if key not in data:
+        raise InputError(f"{path}: missing field {name or key}")
+    return data[key]
+
+
+def _numbers(path, values, name, shape) -> np.ndarray:
+    try:
+        array = np.array(values, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{path}: field {name} must hold numbers") from None
+    if array.shape != shape:
+        raise InputError(f"{path}: field {name} must have shape {shape}, got {array.shape}")
+    if not np.all(np.isfinite(array)):
+        raise InputError(f"{path}: field {name} holds a NaN or infinite value")
+    return array

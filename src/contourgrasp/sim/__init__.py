@@ -1,0 +1,34 @@
+"""Physics simulation of the thesis's grasping experiment (4.1.3-4.2.4) in MuJoCo.
+
+* :mod:`~contourgrasp.sim.objects` -- the five test objects and mesh files
+* :mod:`~contourgrasp.sim.hand_model` -- the one-motor, tendon-driven hand built from a preset
+* :mod:`~contourgrasp.sim.scene` -- table, object, top-down camera, hand
+* :mod:`~contourgrasp.sim.render` -- RGB-D pictures by ray casting
+* :mod:`~contourgrasp.sim.trial` -- grasp execution and trials
+* :mod:`~contourgrasp.sim.measure` -- fingertip paths against the preset
+
+Needs ``mujoco`` (4.x: ``mj_multiRay`` takes a ``normal`` argument), ``trimesh``
+and ``coacd``; nothing here uses OpenGL (``MUJOCO_GL`` defaults to ``disable``).
+
+Example::
+
+    from contourgrasp.sim import run_trial
+    record = run_trial("can", seed=0, planner=my_planner)   # my_planner(rgb, depth, intrinsics)
+    record.success, record.cause, record.fingers_in_contact
+"""
+
+from .hand_model import TIMINGS, FingerTiming, HandDesign, HandModel, build_hand
+from .measure import fingertip_path_error, fingertip_paths
+from .objects import THESIS_OBJECTS, ObjectSpec, Part, mesh_object, object_spec
+from .render import DepthNoise, render
+from .scene import Camera, Intrinsics, Placement, Scene, Workspace, build_scene
+from .trial import (DROPPED, FAILURE_CAUSES, NO_PLAN, PUSHED, SLIPPED, STRUCK, Execution, GraspOutcome, TrialRecord,
+                    execute_grasp, hand_pose_from_matrix, pose_matrix, run_trial, scripted_grasp)
+
+__all__ = [
+    "Camera", "DROPPED", "DepthNoise", "Execution", "FAILURE_CAUSES", "FingerTiming", "GraspOutcome", "HandDesign",
+    "HandModel", "Intrinsics", "NO_PLAN", "ObjectSpec", "PUSHED", "Part", "Placement", "SLIPPED", "STRUCK", "Scene",
+    "THESIS_OBJECTS", "TIMINGS", "TrialRecord", "Workspace", "build_hand", "build_scene", "execute_grasp",
+    "fingertip_path_error", "fingertip_paths", "hand_pose_from_matrix", "mesh_object", "object_spec", "pose_matrix",
+    "render", "run_trial", "scripted_grasp",
+]

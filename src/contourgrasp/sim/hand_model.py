@@ -1,0 +1,374 @@
+"""A physical, underactuated hand built from a 2-D hand preset (thesis 4.1.2, Table 4.3).
+
+The qbHand of the experiments has one motor; a tendon runs through every
+flexion joint, so a finger that touches the object stops while the others keep
+closing, and all of them then squeeze with the tendon's force. This module
+builds that idea as MuJoCo XML from a :class:`~contourgrasp.hand.Hand` whose
+fingers close on rays.
+
+Geometry (our reading)
+----------------------
+The preset's 2-D hand frame (origin at the reference point) is the plane of the
+palm's underside, parallel to the image plane; the 3-D hand frame adds z along
+the camera's z (down, toward the table). Every finger is a planar chain of two
+links (proximal, distal) hanging from a knuckle; both hinges are perpendicular
+to the vertical plane that holds the finger's open tip, ``start``, and its
+closing direction. So the fingertip moves in that plane only and its projection
+onto the image plane stays on the preset's ray ``start + lam * closing_direction``
+whatever the joint angles. The fingertip is the centre of the distal link's end
+cap. In free space both joints flex together (distal = ``distal_ratio`` x
+proximal); the joint ranges are solved so that the fully closed finger ends
+exactly ``travel`` along the ray.
+
+The open finger leans outward by a tilt chosen so that the tip's height varies
+least over its closing (it swings through the vertical, like a pendulum through
+its lowest point): a tip that rose as it closed -- 5 cm for a thumb hanging
+straight down -- would pass over flat objects such as the stones. What is left
+is a few millimetres for a finger, about a centimetre for the thumb. Knuckles
+hang at depths that bring every fingertip's lowest point to the same depth,
+``tip_depth`` below the palm. Fingers are ``min_length`` long or
+``length_per_travel`` times their travel, whichever is longer.
+
+Actuation
+---------
+One motor pulls a fixed tendon with force ``f = phi * max_tendon_force``
+(``phi`` in [0, 1] is the control). Joint j of a finger sees the torque
+``c_j * f`` (``c_j`` its moment arm) against a preloaded spring. The springs are
+set so that, in free space, a finger starts moving at ``phi = start`` and is
+fully closed at ``phi = end`` (its :class:`FingerTiming`); beyond, the joint limit
+holds it. A blocked finger pushes with the excess torque, up to
+``c_j * max_tendon_force``. Timing ``"thesis"`` reproduces chapter 5's
+observation: the thumb starts first and is fastest, ring and little follow,
+index and middle start last but faster and catch up with ring and little at
+about two thirds of their travel. ``"uniform"``: all fingers start and finish
+together. The thumb (the ``required`` fingers of a preset) gets
+``thumb_strength`` times the moment arms: it opposes four fingers.
+
+Every finger joint has an armature (reflected motor inertia): without it the
+light links overshoot their joint limits.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+from scipy.optimize import brentq, minimize_scalar
+
+from ..errors import InputError
+from ..hand import Hand, Ray
+
+#: Contact bits (contype/conaffinity): the table collides with hand and object,
+#: the hand and the object with the table only; hand-object contacts are explicit pairs.
+TABLE_BIT, OBJECT_BIT, HAND_BIT = 1, 2, 4
+
+
+@dataclass(frozen=True)
+class FingerTiming:
+    """When a finger closes in free space, as fractions of the full tendon force.
+
+    Attributes
+    ----------
+    start : float
+        Tendon-force fraction at which the finger starts to move.
+    end : float
+        Fraction at which it reaches its fully closed pose (``start < end <= 1``).
+    """
+
+    start: float
+    end: float
+
+    def __post_init__(self):
+        if not 0 <= self.start < self.end <= 1:
+            raise ValueError(f"finger timing needs 0 <= start < end <= 1, got {self.start}, {self.end}")
+
+
+#: Closing schedules by name; fingers not listed close as ``"default"``.
+TIMINGS = {
+    "uniform": {"default": FingerTiming(0.05, 0.5)},
+    "thesis": {
+        "thumb": FingerTiming(0.0, 0.35),
+        "ring": FingerTiming(0.08, 0.55),
+        "little": FingerTiming(0.08, 0.55),
+        "index": FingerTiming(0.16, 0.5),
+        "middle": FingerTiming(0.16, 0.5),
+        "default": FingerTiming(0.05, 0.5),
+    },
+}
+
+
+@dataclass(frozen=True)
+class HandDesign:
+    """Physical parameters of the simulated hand (SI units).
+
+    Defaults: fingers about human size (a qbHand finger is ~0.1 m long, ~18 mm
+    wide), a 0.5 kg hand, a grip of roughly 10 N per finger and 20-30 N at the
+    thumb (the qbHand's datasheet gives ~60 N of grasp force in total).
+    """
+
+    min_length: float = 0.10
+    length_per_travel: float = 1.35
+    proximal_fraction: float = 0.55
+    distal_ratio: float = 1.0
+    finger_radius: float = 0.009
+    thumb_radius: float = 0.011
+    finger_density: float = 900.0
+    palm_mass: float = 0.40
+    palm_thickness: float = 0.025
+    palm_margin: float = 0.02
+    max_tendon_force: float = 100.0
+    moment_arms: tuple[float, float] = (0.008, 0.005)
+    thumb_strength: float = 2.5
+    joint_damping: float = 0.05
+    armature: float = 5e-4
+    limit_solref: tuple[float, float] = (0.004, 1.0)
+    limit_solimp: tuple[float, float, float] = (0.95, 0.99, 0.001)
+    base_kp: tuple[float, float] = (4000.0, 200.0)
+    base_kv: tuple[float, float] = (250.0, 20.0)
+
+
+@dataclass(frozen=True)
+class FingerModel:
+    """One simulated finger: its links and joint ranges (hand frame, z down).
+
+    Attributes
+    ----------
+    name : str
+    start : (2,) float
+        Open fingertip, hand frame (the preset's start).
+    direction : (2,) float
+        Unit closing direction.
+    travel : float
+    lengths : (2,) float
+        Proximal and distal link lengths, m.
+    tilt : float
+        Outward lean of the open finger from the vertical, rad.
+    knuckle_depth : float
+        Depth of the knuckle below the palm's underside, m.
+    q_max : (2,) float
+        Joint ranges [0, q_max] from the open pose, rad.
+    radius : float
+    moment_arms : (2,) float
+    timing : FingerTiming
+    """
+
+    name: str
+    start: tuple[float, float]
+    direction: tuple[float, float]
+    travel: float
+    lengths: tuple[float, float]
+    tilt: float
+    knuckle_depth: float
+    q_max: tuple[float, float]
+    radius: float
+    moment_arms: tuple[float, float]
+    timing: FingerTiming
+
+    @property
+    def knuckle(self) -> np.ndarray:
+        """(2,) float: the knuckle's position in the hand frame (inward of the open tip by the lean)."""
+        return np.asarray(self.start) + sum(self.lengths) * np.sin(self.tilt) * np.asarray(self.direction)
+
+    def tip(self, u) -> tuple[np.ndarray, np.ndarray]:
+        """Free-space fingertip at closing fraction ``u`` in [0, 1]: advance along the ray, depth below the knuckle."""
+        return _tip(*self.lengths, self.tilt, self.q_max[0], self.q_max[1] / self.q_max[0], np.asarray(u))
+
+
+@dataclass(frozen=True)
+class HandModel:
+    """The simulated hand: its fingers and MJCF fragments for the scene.
+
+    Attributes
+    ----------
+    hand : Hand
+        The 2-D preset it realises.
+    design : HandDesign
+    fingers : tuple of FingerModel
+    tip_depth : float
+        Depth of the open fingertips below the palm's underside, m.
+    palm_box : (2, 2) float
+        Palm plate extent in the hand frame, ``[[x_min, y_min], [x_max, y_max]]``.
+    """
+
+    hand: Hand
+    design: HandDesign
+    fingers: tuple[FingerModel, ...]
+    tip_depth: float
+    palm_box: tuple[tuple[float, float], tuple[float, float]]
+
+    @property
+    def finger_names(self) -> tuple[str, ...]:
+        return tuple(f.name for f in self.fingers)
+
+    def geom_names(self) -> tuple[str, ...]:
+        """Names of every hand geom (for contact pairs)."""
+        links = [f"{f.name}_{k}" for f in self.fingers for k in ("proximal", "distal")]
+        posts = [f"{f.name}_post" for f in self.fingers if f.knuckle_depth > 0]
+        return ("palm", *posts, *links)
+
+    def body_xml(self) -> str:
+        """The ``<body>`` of the hand on its x, y, z, yaw base, for the world body."""
+        d = self.design
+        (x0, y0), (x1, y1) = self.palm_box
+        t = d.palm_thickness
+        contact = f'contype="{HAND_BIT}" conaffinity="{TABLE_BIT}" group="2"'
+        lines = [
+            '<body name="hand_base" gravcomp="1">',
+            '  <joint name="hand_x" type="slide" axis="1 0 0" damping="20"/>',
+            '  <joint name="hand_y" type="slide" axis="0 1 0" damping="20"/>',
+            '  <joint name="hand_z" type="slide" axis="0 0 1" damping="20"/>',
+            '  <joint name="hand_yaw" type="hinge" axis="0 0 -1" damping="1"/>',
+            '  <body name="palm" quat="0 1 0 0" gravcomp="1">',  # hand frame: x, -y, -z of the world at yaw 0
+            f'    <geom name="palm" type="box" size="{_f((x1 - x0) / 2)} {_f((y1 - y0) / 2)} {_f(t / 2)}" '
+            f'pos="{_f((x0 + x1) / 2)} {_f((y0 + y1) / 2)} {_f(-t / 2)}" mass="{_f(d.palm_mass)}" '
+            f'rgba="0.25 0.25 0.28 1" {contact}/>',
+            '    <site name="hand_origin" pos="0 0 0" size="0.004"/>',
+        ]
+        for f in self.fingers:
+            lines += ["    " + line for line in self._finger_xml(f, contact)]
+        lines += ["  </body>", "</body>"]
+        return "\n".join(lines)
+
+    def _finger_xml(self, f: FingerModel, contact: str) -> list[str]:
+        axis = f"{_f(-f.direction[1])} {_f(f.direction[0])} 0"  # z x direction: positive flexion moves the tip ahead
+        rgba = 'rgba="0.9 0.85 0.75 1"'
+        density = f'density="{_f(self.design.finger_density)}"'
+        lines = []
+        if f.knuckle_depth > 0:
+            kx, ky = f.knuckle
+            lines.append(f'<geom name="{f.name}_post" type="capsule" fromto="{_f(kx)} {_f(ky)} 0 '
+                         f'{_f(kx)} {_f(ky)} {_f(f.knuckle_depth)}" size="{_f(f.radius)}" '
+                         f'mass="0.01" {rgba} {contact}/>')
+        l1, l2 = f.lengths
+        (kx, ky), (dx, dy) = f.knuckle, f.direction
+        lean = -f.tilt / 2  # the open finger is the vertical turned by -tilt about its hinge axis
+        quat = f"{_f(np.cos(lean))} {_f(-dy * np.sin(lean))} {_f(dx * np.sin(lean))} 0"
+        lines += [
+            f'<body name="{f.name}_proximal" pos="{_f(kx)} {_f(ky)} {_f(f.knuckle_depth)}" quat="{quat}" '
+            'gravcomp="1">',
+            f'  <joint name="{f.name}_1" {self._joint_attrs(f, 0, axis)}/>',
+            f'  <geom name="{f.name}_proximal" type="capsule" fromto="0 0 0 0 0 {_f(l1)}" size="{_f(f.radius)}" '
+            f'{density} {rgba} {contact}/>',
+            f'  <body name="{f.name}_distal" pos="0 0 {_f(l1)}" gravcomp="1">',
+            f'    <joint name="{f.name}_2" {self._joint_attrs(f, 1, axis)}/>',
+            f'    <geom name="{f.name}_distal" type="capsule" fromto="0 0 0 0 0 {_f(l2)}" size="{_f(f.radius)}" '
+            f'{density} {rgba} {contact}/>',
+            f'    <site name="{f.name}_tip" pos="0 0 {_f(l2)}" size="0.003"/>',
+            "  </body>",
+            "</body>",
+        ]
+        return lines
+
+    def _joint_attrs(self, f: FingerModel, j: int, axis: str) -> str:
+        # Free-space equilibrium: c f = k (q - q_ref); moving from phi = start to end over [0, q_max].
+        c, q_max = f.moment_arms[j], f.q_max[j]
+        f_max = self.design.max_tendon_force
+        stiffness = c * f_max * (f.timing.end - f.timing.start) / q_max
+        springref = -c * f_max * f.timing.start / stiffness
+        d = self.design
+        return (f'type="hinge" axis="{axis}" range="0 {_f(q_max)}" limited="true" stiffness="{_f(stiffness)}" '
+                f'springref="{_f(springref)}" damping="{_f(d.joint_damping)}" armature="{_f(d.armature)}" '
+                f'solreflimit="{_join(d.limit_solref)}" solimplimit="{_join(d.limit_solimp)}"')
+
+    def tendon_xml(self) -> str:
+        """The fixed tendon through every flexion joint."""
+        joints = [f'    <joint joint="{f.name}_{j + 1}" coef="{_f(f.moment_arms[j])}"/>'
+                  for f in self.fingers for j in range(2)]
+        return "\n".join(['<fixed name="flexion">', *joints, "</fixed>"])
+
+    def actuator_xml(self) -> str:
+        """The tendon motor (control: force fraction in [0, 1]) and the base's position servos."""
+        (kp_lin, kp_yaw), (kv_lin, kv_yaw) = self.design.base_kp, self.design.base_kv
+        servo = ('<position name="{0}" joint="{0}" kp="{1}" kv="{2}" ctrlrange="-10 10"/>')
+        return "\n".join([
+            f'<motor name="flexion" tendon="flexion" gear="{_f(self.design.max_tendon_force)}" ctrlrange="0 1"/>',
+            *(servo.format(j, _f(kp_lin), _f(kv_lin)) for j in ("hand_x", "hand_y", "hand_z")),
+            servo.format("hand_yaw", _f(kp_yaw), _f(kv_yaw)),
+        ])
+
+
+def build_hand(hand: Hand, *, design: HandDesign = HandDesign(), timing: str = "thesis") -> HandModel:
+    """The simulated counterpart of a 2-D hand whose fingers close on rays.
+
+    Raises
+    ------
+    InputError
+        A finger closes on an arc, an unknown ``timing``, or a travel no finger
+        of the design can reach.
+    """
+    if timing not in TIMINGS:
+        raise InputError(f"unknown finger timing {timing!r}; choose one of {', '.join(TIMINGS)}")
+    schedule = TIMINGS[timing]
+    fingers = []
+    for finger in hand.fingers:
+        if not isinstance(finger.trajectory, Ray):
+            raise InputError(f"hand {hand.name!r}: finger {finger.name!r} closes on an arc; "
+                             "the simulated hand realises straight (ray) trajectories only")
+        fingers.append(_finger_model(finger, design, schedule.get(finger.name, schedule["default"])))
+    reach = [float(f.tip(np.linspace(0.0, 1.0, 201))[1].max()) for f in fingers]
+    tip_depth = max(reach)
+    fingers = [replace(f, knuckle_depth=tip_depth - r) for f, r in zip(fingers, reach, strict=True)]
+    knuckles = np.array([f.knuckle for f in fingers])
+    margin = design.palm_margin
+    palm_box = (tuple(knuckles.min(axis=0) - margin), tuple(knuckles.max(axis=0) + margin))
+    return HandModel(hand=hand, design=design, fingers=tuple(fingers), tip_depth=tip_depth, palm_box=palm_box)
+
+
+def _finger_model(finger, design: HandDesign, timing: FingerTiming) -> FingerModel:
+    length = max(design.min_length, design.length_per_travel * finger.travel)
+    l1, l2 = design.proximal_fraction * length, (1 - design.proximal_fraction) * length
+    tilt, q1 = _flattest_swing(l1, l2, design.distal_ratio, finger.travel, finger.name)
+    strength = design.thumb_strength if finger.required else 1.0
+    radius = design.thumb_radius if finger.required else design.finger_radius
+    return FingerModel(
+        name=finger.name,
+        start=finger.start,
+        direction=finger.trajectory.closing_direction,
+        travel=finger.travel,
+        lengths=(l1, l2),
+        tilt=tilt,
+        knuckle_depth=0.0,
+        q_max=(q1, design.distal_ratio * q1),
+        radius=radius,
+        moment_arms=(strength * design.moment_arms[0], strength * design.moment_arms[1]),
+        timing=timing,
+    )
+
+
+def _tip(l1, l2, tilt, q1_max, ratio, u):
+    """Advance along the ray and depth below the knuckle of a tip whose joints flex u * (q1_max, ratio * q1_max)."""
+    a1 = -tilt + u * q1_max
+    a2 = -tilt + u * (1 + ratio) * q1_max  # absolute angle of the distal link from the vertical
+    advance = l1 * (np.sin(a1) - np.sin(-tilt)) + l2 * (np.sin(a2) - np.sin(-tilt))
+    return advance, l1 * np.cos(a1) + l2 * np.cos(a2)
+
+
+def _closing_angle(l1, l2, tilt, ratio, travel) -> float | None:
+    """Proximal range q1_max that advances the tip by ``travel`` without the distal link passing horizontal."""
+    q_top = (np.pi / 2 + tilt) / (1 + ratio)
+    if _tip(l1, l2, tilt, q_top, ratio, 1.0)[0] < travel:
+        return None
+    return float(brentq(lambda q: _tip(l1, l2, tilt, q, ratio, 1.0)[0] - travel, 0.0, q_top, xtol=1e-12))
+
+
+def _flattest_swing(l1, l2, ratio, travel, name) -> tuple[float, float]:
+    """Open-finger tilt and proximal range whose tip path varies least in height."""
+    u = np.linspace(0.0, 1.0, 101)
+
+    def height_range(tilt):
+        q1 = _closing_angle(l1, l2, tilt, ratio, travel)
+        return np.inf if q1 is None else float(np.ptp(_tip(l1, l2, tilt, q1, ratio, u)[1]))
+
+    best = minimize_scalar(height_range, bounds=(0.0, np.pi / 4), method="bounded", options={"xatol": 1e-6})
+    q1 = _closing_angle(l1, l2, best.x, ratio, travel)
+    if q1 is None:
+        raise InputError(f"finger {name!r}: travel {travel} m is beyond the reach of a {l1 + l2:.3f} m finger")
+    return float(best.x), q1
+
+
+def _f(value: float) -> str:
+    return f"{float(value):.9g}"
+
+
+def _join(values) -> str:
+    return " ".join(_f(v) for v in values)

@@ -1,0 +1,300 @@
+"""The simulated workspace of thesis 4.1.3: a table, one object, a camera looking straight down, the hand.
+
+Frames
+------
+World: z up, the table top is the plane z = 0, the camera hangs above the world
+origin. Camera optical frame (the README's convention): x right, y down, z
+forward, i.e. ``R_world_camera = diag(1, -1, -1)`` at ``(0, 0, height)``: the
+image plane is parallel to the table (the thesis's restriction) and a point on
+the table has depth ``height``.
+
+The object is placed with its resting face down at a random position inside
+:class:`Workspace` and a random yaw (both from the seed), then left to settle
+for :data:`SETTLE_TIME` before anything looks at it.
+
+Contacts
+--------
+Object contacts are explicit pairs with the object's own frictions (glove and
+table, see :mod:`contourgrasp.sim.objects`); hand geoms collide with the table
+by their contact bits and never with each other. Solver settings follow what
+makes grasps hold in MuJoCo: elliptic friction cones, ``impratio`` 10, the
+``implicitfast`` integrator, a 2 ms step.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+
+import numpy as np
+
+os.environ.setdefault("MUJOCO_GL", "disable")  # we only ray-cast; never load an OpenGL backend
+import mujoco  # noqa: E402
+
+from ..hand import Hand  # noqa: E402
+from ..io.hand_file import load_hand  # noqa: E402
+from .hand_model import HAND_BIT, TABLE_BIT, HandDesign, HandModel, build_hand  # noqa: E402
+from .objects import ObjectSpec, Part, object_spec  # noqa: E402
+
+#: Simulation step, s.
+TIMESTEP = 0.002
+#: Time the object is left to settle on the table before the picture, s.
+SETTLE_TIME = 0.4
+#: Height of the parked hand, far above the camera (m).
+PARK_HEIGHT = 2.0
+#: Rolling friction of objects on the table, m (torque per unit normal force).
+ROLLING = 0.0005
+#: Rotation from the camera optical frame to the world frame.
+R_WORLD_CAMERA = np.diag([1.0, -1.0, -1.0])
+
+
+@dataclass(frozen=True)
+class Intrinsics:
+    """Pinhole intrinsics and the depth sensor's range.
+
+    Defaults: an Intel RealSense SR300 depth stream at 640 x 480 as librealsense
+    reports it (fx = fy = 472.95 px, principal point (310.21, 245.26), ~68 x 54
+    degrees), with the thesis's range 0.2-1.5 m (4.1.2). Colour is rendered
+    registered to depth, as the thesis uses both in one pixel grid.
+
+    Attributes
+    ----------
+    fx, fy : float
+        Focal lengths in pixels.
+    cx, cy : float
+        Principal point, pixels from the left / top edge.
+    width, height : int
+    depth_min, depth_max : float
+        Readings outside this range are missing (0), m.
+    """
+
+    fx: float = 472.95
+    fy: float = 472.95
+    cx: float = 310.21
+    cy: float = 245.26
+    width: int = 640
+    height: int = 480
+    depth_min: float = 0.2
+    depth_max: float = 1.5
+
+    @property
+    def matrix(self) -> np.ndarray:
+        """(3, 3) float: K = [[fx, 0, cx], [0, fy, cy], [0, 0, 1]]."""
+        return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
+
+    def rays(self) -> np.ndarray:
+        """(height, width, 3) float: per pixel centre, the ray direction with unit z (camera frame)."""
+        u, v = np.meshgrid(np.arange(self.width, dtype=float), np.arange(self.height, dtype=float))
+        return np.stack([(u - self.cx) / self.fx, (v - self.cy) / self.fy, np.ones_like(u)], axis=-1)
+
+
+@dataclass(frozen=True)
+class Camera:
+    """A camera looking straight down from ``height`` m above the table at the world origin."""
+
+    height: float = 0.65
+    intrinsics: Intrinsics = field(default_factory=Intrinsics)
+
+    @property
+    def position(self) -> np.ndarray:
+        """(3,) float: optical centre, world frame."""
+        return np.array([0.0, 0.0, self.height])
+
+    def to_world(self, points) -> np.ndarray:
+        """(..., 3) float: camera-frame points in the world frame."""
+        return np.asarray(points, dtype=float) @ R_WORLD_CAMERA.T + self.position
+
+    def from_world(self, points) -> np.ndarray:
+        """(..., 3) float: world points in the camera frame."""
+        return (np.asarray(points, dtype=float) - self.position) @ R_WORLD_CAMERA
+
+
+@dataclass(frozen=True)
+class Workspace:
+    """Where the object may be put: a rectangle on the table around the camera's axis, m (world x, y)."""
+
+    half_x: float = 0.12
+    half_y: float = 0.08
+
+
+@dataclass(frozen=True)
+class Placement:
+    """The object's placement on the table before settling: world x, y (m) and yaw (rad) about world z."""
+
+    x: float
+    y: float
+    yaw: float
+
+
+class Scene:
+    """A MuJoCo model and state of table, object, hand and camera (mutable: it is simulated).
+
+    Attributes
+    ----------
+    model : mujoco.MjModel
+    data : mujoco.MjData
+    object : ObjectSpec
+    hand : HandModel
+    camera : Camera
+    placement : Placement
+    """
+
+    def __init__(self, model, data, obj: ObjectSpec, hand: HandModel, camera: Camera, placement: Placement):
+        self.model, self.data = model, data
+        self.object, self.hand, self.camera, self.placement = obj, hand, camera, placement
+        self._object_body = model.body("object").id
+        self._palm = model.body("palm").id
+        self._base_qpos = np.array([model.joint(j).qposadr[0] for j in BASE_JOINTS])
+        self._base_ctrl = np.array([model.actuator(j).id for j in BASE_JOINTS])
+        self._base_dofs = np.array([model.joint(j).dofadr[0] for j in BASE_JOINTS])
+        self._tendon_ctrl = model.actuator("flexion").id
+
+    @property
+    def time(self) -> float:
+        return float(self.data.time)
+
+    def object_position(self) -> np.ndarray:
+        """(3,) float: the object's body origin (resting-face centre at placement), world."""
+        return self.data.xpos[self._object_body].copy()
+
+    def object_com(self) -> np.ndarray:
+        """(3,) float: the object's centre of mass, world."""
+        return self.data.xipos[self._object_body].copy()
+
+    def palm_pose(self) -> tuple[np.ndarray, np.ndarray]:
+        """World position (3,) and rotation (3, 3) of the hand frame."""
+        return self.data.xpos[self._palm].copy(), self.data.xmat[self._palm].reshape(3, 3).copy()
+
+    def set_hand(self, x: float, y: float, z: float, yaw: float, closing: float = 0.0) -> None:
+        """Teleport the hand (and its servo targets): hand-frame origin at world (x, y, z), yaw about camera z."""
+        target = np.array([x, y, z, yaw])
+        self.data.qpos[self._base_qpos] = target
+        self.data.qvel[self._base_dofs] = 0.0
+        self.command(target, closing)
+        mujoco.mj_forward(self.model, self.data)
+
+    def command(self, base_target, closing: float) -> None:
+        """Servo targets for the hand base (x, y, z, yaw) and the tendon force fraction."""
+        self.data.ctrl[self._base_ctrl] = base_target
+        self.data.ctrl[self._tendon_ctrl] = closing
+
+    def step(self, duration: float | None = None) -> None:
+        """Advance the simulation by ``duration`` s (one time step if None) at the current commands."""
+        steps = 1 if duration is None else max(1, round(duration / self.model.opt.timestep))
+        mujoco.mj_step(self.model, self.data, nstep=steps)
+
+
+BASE_JOINTS = ("hand_x", "hand_y", "hand_z", "hand_yaw")
+
+
+def build_scene(obj, *, seed: int, hand: Hand | str = "five-finger-linear", design: HandDesign = HandDesign(),
+                timing: str = "thesis", camera: Camera = Camera(), workspace: Workspace = Workspace()) -> Scene:
+    """A settled scene: the object at a seeded random position and yaw, the hand parked out of view.
+
+    Parameters
+    ----------
+    obj : ObjectSpec or str
+        An object, a name of :data:`~contourgrasp.sim.objects.THESIS_OBJECTS` or a mesh path.
+    seed : int
+        Chooses the placement.
+    hand : Hand or str
+        A preset name, hand TOML path or :class:`Hand` with ray fingers.
+    design, timing
+        See :func:`~contourgrasp.sim.hand_model.build_hand`.
+    camera : Camera
+    workspace : Workspace
+    """
+    obj = object_spec(obj)
+    hand_model = build_hand(load_hand(hand), design=design, timing=timing)
+    rng = np.random.default_rng(np.random.SeedSequence([seed, 0]))
+    placement = Placement(x=float(rng.uniform(-workspace.half_x, workspace.half_x)),
+                          y=float(rng.uniform(-workspace.half_y, workspace.half_y)),
+                          yaw=float(rng.uniform(0.0, 2 * np.pi)))
+    model = mujoco.MjModel.from_xml_string(scene_xml(obj, hand_model, placement))
+    data = mujoco.MjData(model)
+    scene = Scene(model, data, obj, hand_model, camera, placement)
+    scene.set_hand(0.0, 0.0, PARK_HEIGHT, 0.0)
+    scene.step(SETTLE_TIME)
+    return scene
+
+
+def scene_xml(obj: ObjectSpec, hand: HandModel, placement: Placement) -> str:
+    """The MJCF text of the whole scene."""
+    assets, geoms = [], []
+    collide_group = 3 if obj.visual else 0  # hidden from the camera when a visual mesh stands for it
+    volumes = np.array([_volume(p) for p in obj.collision])
+    for i, part in enumerate(obj.collision):
+        mass = obj.mass * volumes[i] / volumes.sum()
+        geoms.append(_geom_xml(f"object_{i}", part, assets, group=collide_group, rgba=obj.rgba, mass=mass))
+    for i, part in enumerate(obj.visual):
+        geoms.append(_geom_xml(f"object_visual_{i}", part, assets, group=1, rgba=obj.rgba, mass=0.0))
+    quat = (np.cos(placement.yaw / 2), 0.0, 0.0, np.sin(placement.yaw / 2))
+    pairs = _pairs(obj, hand)
+    return f"""<mujoco model="contourgrasp-sim">
+  <compiler angle="radian" autolimits="true"/>
+  <option timestep="{TIMESTEP}" integrator="implicitfast" cone="elliptic" impratio="10"/>
+  <asset>
+    {chr(10).join(assets)}
+  </asset>
+  <worldbody>
+    <geom name="table" type="box" size="0.6 0.45 0.02" pos="0 0 -0.02" rgba="0.86 0.84 0.78 1"
+          friction="0.5 0.005 0.0001" contype="{TABLE_BIT}" conaffinity="{HAND_BIT}" group="0"/>
+    <body name="object" pos="{placement.x:.9g} {placement.y:.9g} 0.001" quat="{' '.join(f'{q:.9g}' for q in quat)}">
+      <freejoint name="object"/>
+      {chr(10).join(geoms)}
+    </body>
+    {hand.body_xml()}
+  </worldbody>
+  <contact>
+    {chr(10).join(pairs)}
+  </contact>
+  <tendon>
+    {hand.tendon_xml()}
+  </tendon>
+  <actuator>
+    {hand.actuator_xml()}
+  </actuator>
+</mujoco>"""
+
+
+def _pairs(obj: ObjectSpec, hand: HandModel) -> list[str]:
+    # condim 4 with a little torsional friction: fingertip pads resist spinning the object.
+    grip = f'condim="4" friction="{obj.friction_hand} {obj.friction_hand} 0.005 0.0001 0.0001" solref="0.01 1"'
+    # condim 6: a little rolling resistance (0.5 mm, c_rr ~ 0.015 for a can) stops a nudged can rolling off.
+    rest = (f'condim="6" friction="{obj.friction_table} {obj.friction_table} 0.005 {ROLLING} {ROLLING}" '
+            'solref="0.01 1"')
+    pairs = []
+    for i in range(len(obj.collision)):
+        pairs.append(f'<pair geom1="object_{i}" geom2="table" {rest}/>')
+        pairs += [f'<pair geom1="object_{i}" geom2="{g}" {grip}/>' for g in hand.geom_names()]
+    return pairs
+
+
+def _geom_xml(name: str, part: Part, assets: list[str], *, group: int, rgba, mass: float) -> str:
+    collide = 'contype="0" conaffinity="0"'  # object contacts are explicit pairs
+    common = (f'name="{name}" pos="{" ".join(f"{v:.9g}" for v in part.pos)}" '
+              f'quat="{" ".join(f"{v:.9g}" for v in part.quat)}" group="{group}" '
+              f'rgba="{" ".join(f"{v:.4g}" for v in rgba)}" mass="{mass:.9g}" {collide}')
+    if part.kind != "mesh":
+        return f'<geom type="{part.kind}" size="{" ".join(f"{v:.9g}" for v in part.size)}" {common}/>'
+    vertices = " ".join(f"{v:.7g}" for v in np.asarray(part.vertices).ravel())
+    faces = "" if part.faces is None else f' face="{" ".join(str(int(v)) for v in np.asarray(part.faces).ravel())}"'
+    inertia = ' inertia="shell"' if mass == 0 else ""  # drawn-only meshes need not be closed
+    assets.append(f'<mesh name="{name}" vertex="{vertices}"{faces}{inertia}/>')
+    return f'<geom type="mesh" mesh="{name}" {common}/>'
+
+
+def _volume(part: Part) -> float:
+    """Volume of a collision part (m^3): the convex hull for a mesh."""
+    from scipy.spatial import ConvexHull
+
+    s = part.size
+    if part.kind == "mesh":
+        return float(ConvexHull(np.asarray(part.vertices)).volume)
+    return {
+        "box": lambda: 8 * s[0] * s[1] * s[2],
+        "cylinder": lambda: 2 * np.pi * s[0] ** 2 * s[1],
+        "capsule": lambda: 2 * np.pi * s[0] ** 2 * s[1] + 4 / 3 * np.pi * s[0] ** 3,
+        "sphere": lambda: 4 / 3 * np.pi * s[0] ** 3,
+        "ellipsoid": lambda: 4 / 3 * np.pi * s[0] * s[1] * s[2],
+    }[part.kind]()

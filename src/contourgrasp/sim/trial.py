@@ -1,0 +1,394 @@
+"""Grasp execution (thesis 4.1.4, automated end to end) and grasping trials (4.2.4, Table 4.4).
+
+Execution, given the hand pose ``T_camera_hand`` and the approach depth:
+
+1. the hand appears above the pose at a safe height, yaw aligned (the arm's
+   transit is not simulated: nothing touches anything on the way), its
+   fingertips :attr:`Execution.approach_height` above the object's top;
+2. it descends at :attr:`Execution.descend_speed` until the fingertips are just
+   above the table, but never brings the palm closer than
+   :attr:`Execution.palm_clearance` to ``approach_depth`` (so tall objects are
+   grasped lower down the fingers, not crushed by the palm) -- the part the
+   thesis's operator did by hand;
+3. the tendon force ramps to its maximum over :attr:`Execution.close_time`,
+   then squeezes for :attr:`Execution.squeeze_time`;
+4. the hand lifts :attr:`Execution.lift_height` and holds for
+   :attr:`Execution.hold_time`.
+
+Reading of ``approach_depth``: the thesis's z (3.1.1), the depth of the
+object's top as the camera saw it plus the planner's offset; it bounds the
+palm, not the fingertips.
+
+Success (4.1.3, "pick it up without slippage"): the object rose at least
+:attr:`Execution.success_lift` from the start of the lift (closing itself
+raises a lying object a few millimetres) and moved less than
+:attr:`Execution.hold_tolerance` relative to the palm during the hold.
+
+Failure causes (chapter 5), first that applies:
+
+* ``"no feasible plan"`` -- the planner raised :class:`~contourgrasp.errors.NoFeasibleGrasp`;
+* ``"a finger struck the object while descending"`` -- any hand-object contact
+  before closing; the execution stops there, as a robot with a force sensor would;
+* ``"object pushed away before all fingers touched"`` -- the object had moved
+  more than :attr:`Execution.push_tolerance` in the plane when the last finger
+  touched it (or closing ended with fingers still on air), and it was not lifted;
+* ``"slipped during lift"`` -- the object did not rise ``success_lift``;
+* ``"dropped"`` -- it rose, then fell or slid in the hand during the hold.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from ..errors import InputError, NoFeasibleGrasp
+from ..hand import Hand
+from .hand_model import HandDesign
+from .render import render
+from .scene import Camera, Scene, Workspace, build_scene
+
+NO_PLAN = "no feasible plan"
+STRUCK = "a finger struck the object while descending"
+PUSHED = "object pushed away before all fingers touched"
+SLIPPED = "slipped during lift"
+DROPPED = "dropped"
+#: Every failure cause a trial can report.
+FAILURE_CAUSES = (NO_PLAN, STRUCK, PUSHED, SLIPPED, DROPPED)
+#: Angle of the hand's x axis from the object's x axis in :func:`scripted_grasp`, rad.
+SCRIPTED_TILT = math.radians(20.0)
+
+
+@dataclass(frozen=True)
+class Execution:
+    """Motion and success parameters of a grasp execution (SI units)."""
+
+    approach_height: float = 0.05
+    descend_speed: float = 0.10
+    tip_clearance: float = 0.003
+    palm_clearance: float = 0.02
+    settle_time: float = 0.2
+    close_time: float = 1.0
+    squeeze_time: float = 0.3
+    lift_height: float = 0.15
+    lift_speed: float = 0.10
+    hold_time: float = 2.0
+    success_lift: float = 0.10
+    hold_tolerance: float = 0.02
+    push_tolerance: float = 0.01
+
+
+@dataclass(frozen=True)
+class GraspOutcome:
+    """What happened when a grasp was executed.
+
+    Attributes
+    ----------
+    success : bool
+    cause : str or None
+        One of :data:`FAILURE_CAUSES`; None on success.
+    fingers_in_contact : tuple of str
+        Fingers touching the object when the lift starts (empty if aborted before).
+    first_contact : tuple of (str, float)
+        Per finger that touched the object while closing, seconds from the start of closing, in time order.
+    push : float
+        Object's displacement in the table plane when the last finger touched, m.
+    lift : float
+        Object's rise from the start of the lift to the end of the hold, m.
+    hold_drift : float
+        Largest displacement of the object relative to the palm during the hold, m.
+    pose : (3,) float
+        Executed hand pose (x, y, yaw) in the image plane.
+    palm_depth : float
+        Depth of the palm (hand-frame origin) when closing, m.
+    """
+
+    success: bool
+    cause: str | None
+    fingers_in_contact: tuple[str, ...]
+    first_contact: tuple[tuple[str, float], ...]
+    push: float
+    lift: float
+    hold_drift: float
+    pose: tuple[float, float, float]
+    palm_depth: float
+
+
+@dataclass(frozen=True)
+class TrialRecord:
+    """One grasping trial: the scene's seed, the plan, and its outcome.
+
+    Equal records mean the same trial; ``wall_time`` is left out of the comparison.
+
+    Attributes
+    ----------
+    object : str
+    seed : int
+    success : bool
+    cause : str or None
+        One of :data:`FAILURE_CAUSES`; None on success.
+    fingers_in_contact : tuple of str
+    first_contact : tuple of (str, float)
+    push, lift, hold_drift : float
+        See :class:`GraspOutcome` (0 when no grasp was executed).
+    pose : (3,) float or None
+        Planned hand pose (x, y, yaw), image plane; None without a plan.
+    approach_depth : float or None
+    sim_time : float
+        Simulated seconds, settling included.
+    wall_time : float
+        Seconds of wall time for the whole trial (scene, picture, plan, simulation).
+    """
+
+    object: str
+    seed: int
+    success: bool
+    cause: str | None
+    fingers_in_contact: tuple[str, ...]
+    first_contact: tuple[tuple[str, float], ...]
+    push: float
+    lift: float
+    hold_drift: float
+    pose: tuple[float, float, float] | None
+    approach_depth: float | None
+    sim_time: float
+    wall_time: float = field(compare=False)
+
+
+def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finger-linear", noise=True,
+              timing: str = "thesis", design: HandDesign = HandDesign(), camera: Camera = Camera(),
+              workspace: Workspace = Workspace(), execution: Execution = Execution()) -> TrialRecord:
+    """Place the object (seeded), take an RGB-D picture, plan, execute, and record the outcome.
+
+    Parameters
+    ----------
+    object_spec : ObjectSpec or str
+        An object, a name of :data:`~contourgrasp.sim.objects.THESIS_OBJECTS` or a mesh path.
+    seed : int
+        Chooses the placement and the sensor noise; same seed, same record.
+    planner : callable
+        ``planner(rgb, depth, intrinsics) -> (T_camera_hand, approach_depth)``:
+        ``rgb`` (H, W, 3) uint8, ``depth`` (H, W) float32 m (0 = missing),
+        ``intrinsics`` :class:`~contourgrasp.sim.scene.Intrinsics`; returns the
+        (4, 4) hand pose in the camera frame (see :func:`hand_pose_from_matrix`)
+        and the approach depth (m). It may raise ``NoFeasibleGrasp``.
+    hand : Hand or str
+        The hand preset the simulated hand is built from.
+    noise : DepthNoise or bool
+        Sensor noise of the picture (see :func:`~contourgrasp.sim.render.render`).
+    timing, design
+        Finger closing schedule and hand parameters (:mod:`contourgrasp.sim.hand_model`).
+    camera, workspace, execution
+        Scene and execution parameters.
+    """
+    started = time.perf_counter()
+    scene = build_scene(object_spec, seed=seed, hand=hand, design=design, timing=timing, camera=camera,
+                        workspace=workspace)
+    rgb, depth = render(scene, noise=noise, seed=seed)
+    common = {"object": scene.object.name, "seed": seed}
+    try:
+        transform, approach_depth = planner(rgb, depth, camera.intrinsics)
+    except NoFeasibleGrasp:
+        return TrialRecord(**common, success=False, cause=NO_PLAN, fingers_in_contact=(), first_contact=(),
+                           push=0.0, lift=0.0, hold_drift=0.0, pose=None, approach_depth=None,
+                           sim_time=scene.time, wall_time=time.perf_counter() - started)
+    outcome = execute_grasp(scene, transform, approach_depth, execution)
+    fields = {k: v for k, v in asdict(outcome).items() if k != "palm_depth"}
+    return TrialRecord(**common, **fields, approach_depth=float(approach_depth), sim_time=scene.time,
+                       wall_time=time.perf_counter() - started)
+
+
+def hand_pose_from_matrix(transform) -> tuple[float, float, float]:
+    """The image-plane pose (x, y, yaw) of a (4, 4) ``T_camera_hand``.
+
+    The hand frame's z axis must be the camera's z axis (palm facing the
+    table); its x, y axes are the preset's hand frame turned by yaw, i.e. the
+    upper-left block is ``R(yaw) = [[cos, -sin], [sin, cos]]``. The translation's
+    z is not used: the depth comes from the approach depth (4.1.4).
+
+    Raises
+    ------
+    InputError
+        Not a (4, 4) rigid transform with its z axis along the camera's.
+    """
+    t = np.asarray(transform, dtype=float)
+    if t.shape != (4, 4) or not np.all(np.isfinite(t)):
+        raise InputError(f"T_camera_hand must be a finite (4, 4) matrix, got shape {t.shape}")
+    rotation = t[:3, :3]
+    if not np.allclose(rotation.T @ rotation, np.eye(3), atol=1e-6) or t[2, 2] < 1 - 1e-6:
+        raise InputError("T_camera_hand must be a rotation about the camera's z axis (palm facing the table)")
+    return float(t[0, 3]), float(t[1, 3]), math.atan2(t[1, 0], t[0, 0])
+
+
+def pose_matrix(x: float, y: float, yaw: float, depth: float = 0.0) -> np.ndarray:
+    """(4, 4) float: ``T_camera_hand`` of an image-plane pose (x, y, yaw) at ``depth``."""
+    c, s = math.cos(yaw), math.sin(yaw)
+    return np.array([[c, -s, 0.0, x], [s, c, 0.0, y], [0.0, 0.0, 1.0, depth], [0.0, 0.0, 0.0, 1.0]])
+
+
+def execute_grasp(scene: Scene, transform, approach_depth: float,
+                  execution: Execution = Execution()) -> GraspOutcome:
+    """Execute a grasp on a settled scene (module docstring: phases, success, causes)."""
+    x, y, yaw = hand_pose_from_matrix(transform)
+    world_xy = scene.camera.to_world([x, y, 0.0])[:2]
+    top = scene.camera.height - float(approach_depth)  # the planner's idea of the object's top, world z
+    lowest = max(f.radius for f in scene.hand.fingers) + execution.tip_clearance
+    palm_final = max(scene.hand.tip_depth + lowest, top + execution.palm_clearance)
+    palm_start = max(palm_final, top + execution.approach_height + scene.hand.tip_depth)
+    probe = _Probe(scene)
+    pose = (x, y, yaw)
+
+    scene.set_hand(*world_xy, palm_start, yaw)
+    if _descend(scene, probe, world_xy, yaw, palm_start, palm_final, execution):
+        return GraspOutcome(False, STRUCK, (), (), 0.0, 0.0, 0.0, pose, scene.camera.height - palm_final)
+    first_contact, push = _close(scene, probe, world_xy, yaw, palm_final, execution)
+    touching = probe.fingers_touching()
+    lift, lifted, drift = _lift_and_hold(scene, world_xy, yaw, palm_final, execution)
+    success = lift >= execution.success_lift and drift < execution.hold_tolerance
+    if success:
+        cause = None
+    elif lifted < execution.success_lift:
+        cause = PUSHED if push > execution.push_tolerance else SLIPPED
+    else:
+        cause = DROPPED
+    return GraspOutcome(success, cause, touching, first_contact, push, lift, drift, pose,
+                        scene.camera.height - palm_final)
+
+
+class _Probe:
+    """Which hand geoms touch the object, by finger."""
+
+    def __init__(self, scene: Scene):
+        model = scene.model
+        self.scene = scene
+        self.object_geoms = np.flatnonzero(model.geom_bodyid == model.body("object").id)
+        self.finger_of = {}  # hand geom id -> finger index (-1: palm and posts)
+        for name in scene.hand.geom_names():
+            finger = next((i for i, f in enumerate(scene.hand.fingers) if name.startswith(f"{f.name}_")
+                           and not name.endswith("_post")), -1)
+            self.finger_of[model.geom(name).id] = finger
+
+    def touching(self) -> set[int]:
+        """Finger indices (-1 for palm or post) in contact with the object now."""
+        data = self.scene.data
+        if data.ncon == 0:
+            return set()
+        pairs = data.contact.geom[: data.ncon]
+        found = set()
+        for g1, g2 in pairs:
+            if g1 in self.object_geoms and g2 in self.finger_of:
+                found.add(self.finger_of[g2])
+            elif g2 in self.object_geoms and g1 in self.finger_of:
+                found.add(self.finger_of[g1])
+        return found
+
+    def fingers_touching(self) -> tuple[str, ...]:
+        names = self.scene.hand.finger_names
+        return tuple(names[i] for i in sorted(self.touching()) if i >= 0)
+
+
+def _descend(scene, probe, xy, yaw, z_start, z_end, execution) -> bool:
+    """Lower the palm from z_start to z_end; True when the hand touched the object on the way."""
+    steps = max(1, round((z_start - z_end) / execution.descend_speed / scene.model.opt.timestep))
+    for z in np.linspace(z_start, z_end, steps):
+        scene.command([*xy, z, yaw], 0.0)
+        scene.step()
+        if probe.touching():
+            return True
+    for _ in range(round(execution.settle_time / scene.model.opt.timestep)):
+        scene.step()
+        if probe.touching():
+            return True
+    return False
+
+
+def _close(scene, probe, xy, yaw, z, execution):
+    """Ramp the tendon force up, then squeeze; per finger first-contact times and the push before the last."""
+    dt = scene.model.opt.timestep
+    start_xy = scene.object_position()[:2]
+    n_fingers = len(scene.hand.fingers)
+    first: dict[int, float] = {}
+    push_at_last = None
+    max_push = 0.0
+    ramp = round(execution.close_time / dt)
+    for k in range(ramp + round(execution.squeeze_time / dt)):
+        scene.command([*xy, z, yaw], min(1.0, (k + 1) / ramp))
+        scene.step()
+        max_push = max(max_push, float(np.linalg.norm(scene.object_position()[:2] - start_xy)))
+        for i in probe.touching() - first.keys() - {-1}:
+            first[i] = (k + 1) * dt
+            if len(first) == n_fingers:
+                push_at_last = max_push
+    names = scene.hand.finger_names
+    order = tuple((names[i], round(t, 6)) for i, t in sorted(first.items(), key=lambda item: item[1]))
+    return order, max_push if push_at_last is None else push_at_last
+
+
+def _lift_and_hold(scene, xy, yaw, z, execution):
+    """Lift smoothly, hold; the object's rise (end of hold, end of lift) and its largest drift in the hand."""
+    dt = scene.model.opt.timestep
+    z0 = scene.object_com()[2]
+    steps = max(1, round(execution.lift_height / execution.lift_speed / dt))
+    for k in range(steps):
+        u = (k + 1) / steps
+        scene.command([*xy, z + execution.lift_height * u * u * (3 - 2 * u), yaw], 1.0)  # smoothstep
+        scene.step()
+    lifted = scene.object_com()[2] - z0
+    reference = _in_palm(scene)
+    drift = 0.0
+    for _ in range(round(execution.hold_time / dt)):
+        scene.step()
+        drift = max(drift, float(np.linalg.norm(_in_palm(scene) - reference)))
+    return float(scene.object_com()[2] - z0), float(lifted), drift
+
+
+def _in_palm(scene) -> np.ndarray:
+    position, rotation = scene.palm_pose()
+    return rotation.T @ (scene.object_com() - position)
+
+
+def scripted_grasp(scene: Scene, kind: str = "good") -> tuple[np.ndarray, float]:
+    """A hand-made grasp from the object's true pose, for tests: ``(T_camera_hand, approach_depth)``.
+
+    ``"good"``: the centre of opposition -- midway between the thumb's
+    closed tip and the mean closed tip of the other fingers -- over the
+    object's centre of mass, the object's x axis (a lying can's or bottle's
+    axis, the case's length) :data:`SCRIPTED_TILT` off the hand's x axis, so
+    the four fingers close on its long side and the thumb on its end at an
+    angle -- the kind of pose the synthesis picks for the can (its axis 15-35
+    degrees off). With the end square to the thumb, the thumb, closing first,
+    slides the can along its axis before the fingers arrive.
+    ``"bad"``: the object's axis along the hand's x, shifted along it until
+    the object lies beyond the thumb's closed tip: every finger that touches pushes from the
+    same side (chapter 5's failure 2). The approach depth is the object's true
+    top plus 1 cm, as the test planner does.
+    """
+    if kind not in ("good", "bad"):
+        raise InputError(f"scripted grasp kind must be 'good' or 'bad', got {kind!r}")
+    hand = scene.hand.hand
+    rotation_world = scene.data.xmat[scene.model.body("object").id].reshape(3, 3)
+    axis = scene.camera.from_world(scene.camera.position + rotation_world[:, 0])[:2]
+    yaw = math.atan2(axis[1], axis[0]) + (SCRIPTED_TILT if kind == "good" else 0.0)
+    thumbs = np.array([f.required for f in hand.fingers])
+    target = (hand.ends[thumbs].mean(axis=0) + hand.ends[~thumbs].mean(axis=0)) / 2
+    if kind == "bad":
+        thumb_end = hand.ends[thumbs, 0].min()
+        half_length = float(np.ptp(scene.object.points()[:, 0])) / 2
+        target[0] = thumb_end + half_length + 0.01
+    centre = scene.camera.from_world(scene.object_com())[:2]
+    x, y = centre - _rotate(target, yaw)
+    top = float(scene.camera.from_world(_world_points(scene))[:, 2].min())
+    return pose_matrix(x, y, yaw, top + 0.01), top + 0.01
+
+
+def _rotate(point, yaw) -> np.ndarray:
+    c, s = math.cos(yaw), math.sin(yaw)
+    return np.array([c * point[0] - s * point[1], s * point[0] + c * point[1]])
+
+
+def _world_points(scene: Scene) -> np.ndarray:
+    body = scene.model.body("object").id
+    rotation = scene.data.xmat[body].reshape(3, 3)
+    return scene.object.points() @ rotation.T + scene.data.xpos[body]

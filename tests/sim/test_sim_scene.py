@@ -1,0 +1,72 @@
+"""Scene and rendering: geometry of the top-down camera, noise, the test planner on a rendered can."""
+
+import numpy as np
+import pytest
+
+import contourgrasp
+from contourgrasp.sim import Camera, DepthNoise, build_scene, hand_pose_from_matrix, render
+from contourgrasp.sim.scene import Workspace
+from sim_planner import depth_planner
+
+
+@pytest.fixture(scope="module")
+def can_scene():
+    return build_scene("can", seed=3)
+
+
+def test_render_types_and_shapes(can_scene):
+    rgb, depth = render(can_scene)
+    intr = can_scene.camera.intrinsics
+    assert rgb.dtype == np.uint8 and rgb.shape == (intr.height, intr.width, 3)
+    assert depth.dtype == np.float32 and depth.shape == (intr.height, intr.width)
+
+
+def test_table_depth_equals_camera_height(can_scene):
+    _, depth = render(can_scene)
+    # The workspace keeps the object well inside the view, so the image corners see the table.
+    corners = np.concatenate([depth[:20, :20].ravel(), depth[-20:, -20:].ravel()])
+    assert np.all(np.abs(corners - can_scene.camera.height) < 1e-3)
+
+
+def test_object_top_depth(can_scene):
+    _, depth = render(can_scene)
+    # A can lying on its side: its top is 0.066 m above the table.
+    assert abs(depth[depth > 0].min() - (can_scene.camera.height - 0.066)) < 1e-3
+
+
+def test_depth_outside_the_sensor_range_is_missing():
+    scene = build_scene("can", seed=0, camera=Camera(height=2.0))
+    _, depth = render(scene)
+    assert not depth.any()
+
+
+def test_noise_is_seeded_and_drops_edge_pixels(can_scene):
+    _, exact = render(can_scene)
+    _, a = render(can_scene, noise=True, seed=5)
+    _, b = render(can_scene, noise=True, seed=5)
+    _, c = render(can_scene, noise=DepthNoise(), seed=6)
+    np.testing.assert_array_equal(a, b)
+    assert not np.array_equal(a, c)
+    table = (exact > can_scene.camera.height - 1e-3) & (a > 0)
+    residual = a[table] - exact[table]
+    assert 0.5e-3 < residual.std() < 3e-3  # a few mm at 0.65 m, like the SR300
+    assert 0 < np.count_nonzero((a == 0) & (exact > 0)) < 0.01 * a.size  # holes only along edges
+
+
+def test_placement_is_seeded_and_inside_the_workspace():
+    first = build_scene("can", seed=11).placement
+    assert build_scene("can", seed=11).placement == first
+    assert build_scene("can", seed=12).placement != first
+    workspace = Workspace()
+    assert abs(first.x) <= workspace.half_x and abs(first.y) <= workspace.half_y
+
+
+def test_planner_finds_the_can(can_scene):
+    rgb, depth = render(can_scene, noise=True, seed=1)
+    transform, approach = depth_planner(rgb, depth, can_scene.camera.intrinsics)
+    x, y, yaw = hand_pose_from_matrix(transform)
+    hand = contourgrasp.load_hand("five-finger-linear")
+    grasp_centre = contourgrasp.hand.to_image(hand.grasp_centre[None], (x, y, yaw))[0]
+    can_centre = can_scene.camera.from_world(can_scene.object_com())[:2]
+    assert np.linalg.norm(grasp_centre - can_centre) < 0.04
+    assert abs(approach - (can_scene.camera.height - 0.066 + 0.01)) < 0.005

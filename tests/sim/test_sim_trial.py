@@ -1,0 +1,76 @@
+"""Grasp execution and trials: scripted good and bad grasps, the causes, determinism."""
+
+import numpy as np
+import pytest
+
+from contourgrasp import InputError, NoFeasibleGrasp
+from contourgrasp.sim import (FAILURE_CAUSES, Camera, ObjectSpec, Part, Workspace, build_scene, execute_grasp,
+                              pose_matrix, run_trial)
+from contourgrasp.sim.trial import NO_PLAN, STRUCK, scripted_grasp
+from sim_planner import depth_planner
+
+
+def test_scripted_good_grasp_lifts_the_can():
+    scene = build_scene("can", seed=4)
+    outcome = execute_grasp(scene, *scripted_grasp(scene, "good"))
+    assert outcome.success and outcome.cause is None
+    assert outcome.lift >= 0.10 and outcome.hold_drift < 0.02
+    assert {"thumb", "index"} <= set(outcome.fingers_in_contact)
+
+
+def test_scripted_bad_grasp_fails():
+    scene = build_scene("can", seed=4)
+    outcome = execute_grasp(scene, *scripted_grasp(scene, "bad"))
+    assert not outcome.success
+    assert outcome.cause in FAILURE_CAUSES and outcome.cause != NO_PLAN
+    assert "thumb" not in outcome.fingers_in_contact
+
+
+def test_descending_onto_the_object_is_a_strike():
+    scene = build_scene("can", seed=4)
+    centre = scene.camera.from_world(scene.object_com())[:2]
+    middle_start = np.array([0.0, 0.215])  # the middle finger of five-finger-linear comes down on the can
+    outcome = execute_grasp(scene, pose_matrix(*(centre - middle_start), 0.0), scene.camera.height - 0.056)
+    assert outcome.cause == STRUCK and not outcome.success
+
+
+def test_trial_with_the_test_planner_lifts_the_can():
+    record = run_trial("can", seed=0, planner=depth_planner)
+    print("\n", record)
+    assert record.success, record
+    assert len(record.fingers_in_contact) >= 4
+    assert record.sim_time > 5.0
+    assert record.wall_time < 5.0
+
+
+def test_too_large_object_is_no_feasible_plan():
+    # A 0.8 m disc right under a camera raised to 1 m, so that it is whole in the picture: every pose
+    # of the synthesis grid (within 0.15 m of its centre) starts some fingertip inside it. (Smaller
+    # discs still let the fingers hook its rim.)
+    platter = ObjectSpec("platter", (Part("cylinder", (0.40, 0.01), pos=(0.0, 0.0, 0.01)),), mass=3.0,
+                         friction_hand=0.6, friction_table=0.4)
+    record = run_trial(platter, seed=0, planner=depth_planner, workspace=Workspace(0.0, 0.0),
+                       camera=Camera(height=1.0))
+    assert not record.success and record.cause == NO_PLAN
+    assert record.pose is None and record.fingers_in_contact == ()
+
+
+def test_planner_raising_no_feasible_grasp_is_recorded():
+    def planner(rgb, depth, intrinsics):
+        raise NoFeasibleGrasp("nothing")
+    record = run_trial("case", seed=1, planner=planner)
+    assert record.cause == NO_PLAN
+
+
+def test_same_seed_same_record():
+    first = run_trial("bottle", seed=2, planner=depth_planner)
+    second = run_trial("bottle", seed=2, planner=depth_planner)
+    assert first == second
+    assert first.wall_time != second.wall_time or first.wall_time > 0
+
+
+def test_pose_must_face_the_table():
+    scene = build_scene("can", seed=0)
+    flipped = np.diag([1.0, -1.0, -1.0, 1.0])
+    with pytest.raises(InputError, match="camera's z"):
+        execute_grasp(scene, flipped, 0.6)
