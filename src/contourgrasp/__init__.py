@@ -5,6 +5,9 @@ The pipeline, one module per stage (thesis chapter 3):
 * :mod:`contourgrasp.efd` — contour model: Elliptic Fourier Descriptors, curvature (3.2)
 * :mod:`contourgrasp.hand` — finger trajectories and hands (3.3)
 * :mod:`contourgrasp.synthesis` — inner and outer problems, the grasp plan (3.4)
+* :mod:`contourgrasp.perception` — RGB-D frame -> object contour in meters (3.1)
+* :mod:`contourgrasp.pipeline` — perception + synthesis -> 6-DoF grasp pose (4.1.4)
+* :mod:`contourgrasp.sim` — MuJoCo simulation of the grasping experiment (4.2.4)
 * :mod:`contourgrasp.visualize` — figures
 * :mod:`contourgrasp.io` — file formats (contours, hands, plans)
 * :mod:`contourgrasp.cli` — the ``contourgrasp`` command
@@ -60,8 +63,20 @@ def synthesize(
     )
 
 
+def plan_grasp(rgb, depth, intrinsics, hand="five-finger-linear", **options):
+    """Plan a grasp on one RGB-D frame; ``hand`` is a preset name, a TOML path or a :class:`Hand`.
+
+    Returns an :class:`contourgrasp.pipeline.ImageGraspPlan` (``.plan`` is the
+    :class:`GraspPlan`, ``.T_camera_hand`` the 6-DoF pose); see
+    :func:`contourgrasp.pipeline.plan_grasp` for the options.
+    """
+    from .pipeline import plan_grasp as _plan_grasp
+
+    return _plan_grasp(rgb, depth, intrinsics, load_hand(hand), **options)
+
+
 __all__ = [
     "Arc", "ContourError", "EFD", "Finger", "GraspPlan", "Hand", "HandFileError", "InputError",
     "NoFeasibleGrasp", "Ray", "UnitWarning", "efd", "example_contour", "example_names", "hand",
-    "load_hand", "preset_names", "read_contour", "synthesis", "synthesize",
+    "load_hand", "plan_grasp", "preset_names", "read_contour", "synthesis", "synthesize",
 ]

@@ -61,17 +61,24 @@ def _parser() -> argparse.ArgumentParser:
                     f"or example:NAME with NAME in {', '.join(example_names())}")
     synth = sub.add_parser("synth", help="plan a grasp on a metric contour")
     synth.add_argument("--contour", required=True, help=contour_help)
-    synth.add_argument("--hand", default="five-finger-linear", help="preset name or hand TOML file")
-    synth.add_argument("--harmonics", type=_positive_int, default=4)
-    synth.add_argument("--curvature", choices=efd.CURVATURE_MODES, default="paper")
-    synth.add_argument("--xy-step", type=_positive_float, default=0.05, help="grid step in x and y, m")
-    synth.add_argument("--yaw-step-deg", type=_positive_float, default=2.0, help="grid step in yaw, degrees")
-    synth.add_argument("--d-max", type=_non_negative_float, nargs="+", default=[0.15], metavar="D",
-                       help="D_max (one value, or x and y), m")
-    synth.add_argument("--d-min", type=_non_negative_float, default=0.015, help="D_min, m")
-    synth.add_argument("--top-k", type=_positive_int, default=10, help="ranked distinct poses to report")
-    synth.add_argument("--out", help="write the plan JSON here (default: print it)")
-    synth.add_argument("--plot", help="write the plan picture (PNG) here")
+    _add_synthesis_options(synth)
+
+    plan = sub.add_parser("plan", help="plan a grasp on an RGB-D frame (segmentation -> contour -> 6-DoF pose)")
+    plan.add_argument("--rgb", help="colour image (PNG/JPG)")
+    plan.add_argument("--depth", required=True, help="depth: float .npy in meters, or 16-bit PNG / integer .npy")
+    plan.add_argument("--intrinsics", required=True,
+                      help="YAML/JSON {fx, fy, cx, cy, width, height}, ROS camera_info YAML, or BerkeleyAutomation .intr")
+    plan.add_argument("--depth-scale", type=_positive_float, default=0.001,
+                      help="meters per unit of integer depth images (default 0.001: millimetres)")
+    plan.add_argument("--segment", choices=("auto", "rgb", "depth"), default="auto")
+    plan.add_argument("--mask", help="binary image of the object: skips segmentation")
+    plan.add_argument("--depth-mode", choices=("max", "plane"), default="max",
+                      help="contour plane: 'max' (thesis eq 3.1-3.2) or the object's top 'plane'")
+    plan.add_argument("--no-fill-holes", action="store_true", help="do not fill small depth holes")
+    plan.add_argument("--approach-offset", type=float, default=0.01, help="added to the nearest depth, m")
+    plan.add_argument("--standoff", type=_non_negative_float, default=0.10, help="pre-grasp distance, m")
+    plan.add_argument("--extrinsics", help="T_base_camera (4x4): .npy, .txt, .json, .yaml or autolab .tf")
+    _add_synthesis_options(plan)
 
     harm = sub.add_parser("efd", help="approximate a contour with several harmonic counts")
     harm.add_argument("--contour", required=True, help=contour_help)
@@ -79,6 +86,53 @@ def _parser() -> argparse.ArgumentParser:
     harm.add_argument("--curvature", choices=efd.CURVATURE_MODES, default="paper")
     harm.add_argument("--plot", help="write the figure (PNG) here")
     return parser
+
+
+def _add_synthesis_options(parser) -> None:
+    parser.add_argument("--hand", default="five-finger-linear", help="preset name or hand TOML file")
+    parser.add_argument("--harmonics", type=_positive_int, default=4)
+    parser.add_argument("--curvature", choices=efd.CURVATURE_MODES, default="paper")
+    parser.add_argument("--xy-step", type=_positive_float, default=0.05, help="grid step in x and y, m")
+    parser.add_argument("--yaw-step-deg", type=_positive_float, default=2.0, help="grid step in yaw, degrees")
+    parser.add_argument("--d-max", type=_non_negative_float, nargs="+", default=[0.15], metavar="D",
+                        help="D_max (one value, or x and y), m")
+    parser.add_argument("--d-min", type=_non_negative_float, default=0.015, help="D_min, m")
+    parser.add_argument("--top-k", type=_positive_int, default=10, help="ranked distinct poses to report")
+    parser.add_argument("--out", help="write the plan JSON here (default: print it)")
+    parser.add_argument("--plot", help="write the plan picture (PNG) here")
+
+
+def _synthesis_options(args) -> dict:
+    if len(args.d_max) > 2:
+        raise InputError(f"--d-max takes one or two values, got {len(args.d_max)}")
+    return {
+        "harmonics": args.harmonics,
+        "curvature": args.curvature,
+        "xy_step": args.xy_step,
+        "yaw_step": math.radians(args.yaw_step_deg),
+        "d_max": tuple(args.d_max) if len(args.d_max) == 2 else args.d_max[0],
+        "d_min": args.d_min,
+        "top_k": args.top_k,
+    }
+
+
+def _write_outputs(args, data: dict, figure, summary: str) -> None:
+    with atomic_outputs(args.out, args.plot) as (out, plot):
+        if out is not None:
+            write_json(data, out)
+        if plot is not None:
+            figure().savefig(plot, dpi=110, format="png")
+    if args.out is None:
+        print(json.dumps(data, indent=2))
+    else:
+        print(f"{summary} -> {args.out}")
+
+
+def _summary(plan) -> str:
+    x, y, yaw = plan.pose
+    touching = sum(not f.missed for f in plan.fingers)
+    return (f"pose x={x:.4f} m y={y:.4f} m yaw={math.degrees(yaw):.1f} deg, cost {plan.cost.total:.2f}, "
+            f"{touching}/{len(plan.fingers)} fingers touch, {plan.timing_ms['total']:.0f} ms")
 
 
 def _hands(_args) -> int:
@@ -90,34 +144,44 @@ def _hands(_args) -> int:
 
 
 def _synth(args) -> int:
-    if len(args.d_max) > 2:
-        raise InputError(f"--d-max takes one or two values, got {len(args.d_max)}")
-    plan = synthesize(
-        _contour(args.contour),
-        load_hand(args.hand),
-        harmonics=args.harmonics,
-        curvature=args.curvature,
-        xy_step=args.xy_step,
-        yaw_step=math.radians(args.yaw_step_deg),
-        d_max=tuple(args.d_max) if len(args.d_max) == 2 else args.d_max[0],
-        d_min=args.d_min,
-        top_k=args.top_k,
-    )
-    data = plan_to_dict(plan)
-    with atomic_outputs(args.out, args.plot) as (out, plot):
-        if out is not None:
-            write_json(data, out)
-        if plot is not None:
-            from .visualize import plan_figure
+    plan = synthesize(_contour(args.contour), load_hand(args.hand), **_synthesis_options(args))
 
-            plan_figure(plan).savefig(plot, dpi=110, format="png")
-    if args.out is None:
-        print(json.dumps(data, indent=2))
-    else:
-        x, y, yaw = plan.pose
-        touching = sum(not f.missed for f in plan.fingers)
-        print(f"pose x={x:.4f} m y={y:.4f} m yaw={math.degrees(yaw):.1f} deg, cost {plan.cost.total:.2f}, "
-              f"{touching}/{len(plan.fingers)} fingers touch, {plan.timing_ms['total']:.0f} ms -> {args.out}")
+    def figure():
+        from .visualize import plan_figure
+
+        return plan_figure(plan)
+
+    _write_outputs(args, plan_to_dict(plan), figure, _summary(plan))
+    return EXIT_OK
+
+
+def _plan(args) -> int:
+    from .io.camera_file import read_extrinsics, read_mask, read_rgbd
+    from .io.plan_file import image_plan_to_dict
+    from .pipeline import plan_grasp
+
+    frame = read_rgbd(args.rgb, args.depth, args.intrinsics, depth_scale=args.depth_scale)
+    result = plan_grasp(
+        frame.rgb,
+        frame.depth,
+        frame.intrinsics,
+        load_hand(args.hand),
+        segment=args.segment,
+        mask=None if args.mask is None else read_mask(args.mask),
+        depth_mode=args.depth_mode,
+        fill_holes=not args.no_fill_holes,
+        approach_offset=args.approach_offset,
+        standoff=args.standoff,
+        T_base_camera=None if args.extrinsics is None else read_extrinsics(args.extrinsics),
+        **_synthesis_options(args),
+    )
+
+    def figure():
+        from .visualize import image_plan_figure
+
+        return image_plan_figure(result, frame.rgb)
+
+    _write_outputs(args, image_plan_to_dict(result), figure, _summary(result.plan))
     return EXIT_OK
 
 
@@ -137,7 +201,7 @@ def _efd(args) -> int:
     return EXIT_OK
 
 
-COMMANDS = {"hands": _hands, "synth": _synth, "efd": _efd}
+COMMANDS = {"hands": _hands, "synth": _synth, "plan": _plan, "efd": _efd}
 
 
 def main(argv=None) -> int:

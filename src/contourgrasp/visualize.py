@@ -7,6 +7,7 @@ nothing here touches global plotting state; save them with ``fig.savefig``.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -103,4 +104,47 @@ def harmonics_figure(contour_xy, harmonics: Sequence[int] = (1, 2, 4, 8), *, cur
         ax.set_title(f"{k} harmonic{'s' if k > 1 else ''}")
         _finish_axes(ax, scale=0.02)
     fig.suptitle(f"EFD approximation; concave stretches in blue ({curvature} curvature)", fontsize=10)
+    return fig
+
+
+def _to_pixels(result, points_xy) -> np.ndarray:
+    cam = result.camera
+    p = result.metric.to_camera(points_xy)
+    return np.c_[cam.fx * p[:, 0] / p[:, 2] + cam.cx, cam.fy * p[:, 1] / p[:, 2] + cam.cy]
+
+
+def image_plan_figure(result, rgb=None) -> Figure:
+    """An RGB-D plan: the image with contour, hand and grasp points (left) beside the metric plan (right).
+
+    ``result`` is a :class:`contourgrasp.pipeline.ImageGraspPlan`; ``rgb`` the
+    colour image (the depth-derived mask is shown when it is None).
+    """
+    plan = result.plan
+    fig = Figure(figsize=(16, 7), layout="constrained")
+    image_ax, plan_ax = fig.subplots(1, 2, width_ratios=[1.2, 1])
+    image_ax.imshow(rgb if rgb is not None else result.segmentation.mask, cmap="gray")
+    contour = np.vstack([result.segmentation.contour_px, result.segmentation.contour_px[:1]])
+    image_ax.plot(*contour.T, color="yellow", lw=1.2, label=f"contour ({result.segmentation.method})")
+    for i, (finger, contact) in enumerate(zip(plan.hand.fingers, plan.fingers)):
+        colour = FINGER_COLOURS[i % len(FINGER_COLOURS)]
+        path = _to_pixels(result, to_image(finger.points(np.linspace(0, finger.travel, 30)), plan.pose))
+        image_ax.plot(*path.T, color=colour, lw=1.5, ls="--" if contact.missed else "-")
+        image_ax.plot(*_to_pixels(result, [contact.start])[0], "o", color=colour, mfc="white")
+        grasp = _to_pixels(result, [contact.grasp_point])[0]
+        image_ax.plot(*grasp, "X" if contact.missed else "*", color=colour, ms=12, mec="black", mew=0.6)
+        image_ax.annotate(finger.name, grasp, textcoords="offset points", xytext=(6, 6), color=colour, fontsize=9)
+    pixels = np.vstack([contour, _to_pixels(result, [f.start for f in plan.fingers])])
+    lo, hi = pixels.min(axis=0) - 40, pixels.max(axis=0) + 40
+    image_ax.set_xlim(max(lo[0], 0), min(hi[0], result.camera.width))
+    image_ax.set_ylim(min(hi[1], result.camera.height), max(lo[1], 0))
+    tilt = result.metric.tilt
+    image_ax.set_title(f"camera image, approach depth {result.metric.approach_depth:.3f} m"
+                       + ("" if tilt is None else f", table tilt {math.degrees(tilt):.1f}°"), fontsize=10)
+    image_ax.legend(loc="upper left", fontsize=8)
+    draw_plan(plan_ax, plan)
+    _finish_axes(plan_ax)
+    x, y, yaw = plan.pose
+    plan_ax.set_title(f"{plan.hand.name} in the {result.metric.frame} plane: x={x:.3f} m, y={y:.3f} m, "
+                      f"yaw={math.degrees(yaw):.0f}°, cost {plan.cost.total:.1f}", fontsize=10)
+    plan_ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     return fig

@@ -73,6 +73,36 @@ def plan_to_dict(plan: GraspPlan) -> dict:
     }
 
 
+def image_plan_to_dict(result) -> dict:
+    """``plan_to_dict`` of the planar plan plus the camera, segmentation and 6-DoF poses of an ImageGraspPlan."""
+    data = plan_to_dict(result.plan)
+    cam, seg, metric = result.camera, result.segmentation, result.metric
+    data["camera"] = {"fx": cam.fx, "fy": cam.fy, "cx": cam.cx, "cy": cam.cy, "width": cam.width, "height": cam.height}
+    data["segmentation"] = {
+        "method": seg.method,
+        "area_px": int(seg.area_px),
+        "contour_px": np.asarray(seg.contour_px).tolist(),
+        "invalid_depth_px": metric.invalid_depth_px,
+        "filled_depth_px": result.filled_depth_px,
+        "warnings": list(seg.warnings),
+    }
+    data["planning_frame"] = {
+        "frame": metric.frame,
+        "depth_mode": metric.depth_mode,
+        "tilt": metric.tilt,
+        "z_max": metric.z_max,
+        "R_camera_plane": metric.R_camera_plane.tolist(),
+        "origin": metric.origin.tolist(),
+    }
+    data["approach_depth"] = metric.approach_depth
+    data["T_camera_hand"] = result.T_camera_hand.tolist()
+    data["quaternion_xyzw"] = result.quaternion_xyzw.tolist()
+    data["T_camera_pregrasp"] = result.T_camera_pregrasp.tolist()
+    if result.T_base_hand is not None:
+        data["T_base_hand"] = result.T_base_hand.tolist()
+    return data
+
+
 @contextlib.contextmanager
 def atomic_outputs(*paths):
     """Yield temporary paths beside ``paths``; move them into place only if the block succeeds.

@@ -1,0 +1,161 @@
+"""End to end: one top-down RGB-D frame -> a 6-DoF grasp pose (thesis 3.1, 3.1.1, 4.1.4).
+
+Perception finds the object and its contour in meters in a *planning frame*
+(the camera frame for a top-down camera, a frame on the table's plane for a
+tilted one); synthesis plans (x, y, yaw) in that frame; this module turns the
+result into poses a robot can execute.
+
+Hand frame (``T_camera_hand``)
+    Origin at the hand's reference point of the preset (the origin of its
+    hand file's coordinates) placed at the planned (x, y) and at the approach
+    depth along the approach axis; x and y axes the hand file's axes turned by
+    yaw; z axis the approach direction: the camera's z (palm facing along it,
+    toward the table) or, for a tilted camera, the table's normal pointing
+    into the table. ``approach_depth`` = nearest valid depth inside the contour
+    plus ``approach_offset`` (section 3.1.1): the fingertips' plane reaches
+    that far, ``approach_offset`` below the object's top.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from . import perception
+from .errors import InputError
+from .hand import Hand
+from .perception import Intrinsics, MetricContour, Segmentation
+from .synthesis import GraspPlan, synthesize
+
+SEGMENT_CHOICES = ("auto", "rgb", "depth")
+
+
+@dataclass(frozen=True, eq=False)
+class ImageGraspPlan:
+    """A grasp planned on an RGB-D frame.
+
+    Attributes
+    ----------
+    plan : GraspPlan
+        The planar plan, in the planning frame of ``metric``.
+    segmentation : Segmentation
+        Mask and pixel contour of the object.
+    metric : MetricContour
+        The contour in meters, its planning frame and the approach depth.
+    camera : Intrinsics
+    T_camera_hand, T_camera_pregrasp : (4, 4) float
+        The grasp pose and the pose ``standoff`` m back along the approach axis.
+    T_base_hand : (4, 4) float or None
+        The grasp pose in the robot's base frame, when extrinsics were given.
+    filled_depth_px : int
+        Depth holes filled before use.
+    """
+
+    plan: GraspPlan
+    segmentation: Segmentation
+    metric: MetricContour
+    camera: Intrinsics
+    T_camera_hand: np.ndarray
+    T_camera_pregrasp: np.ndarray
+    T_base_hand: np.ndarray | None
+    filled_depth_px: int
+
+    @property
+    def quaternion_xyzw(self) -> np.ndarray:
+        """(4,) float: rotation of ``T_camera_hand`` as a unit quaternion (x, y, z, w)."""
+        return Rotation.from_matrix(self.T_camera_hand[:3, :3]).as_quat()
+
+
+def plan_grasp(
+    rgb,
+    depth,
+    intrinsics: Intrinsics,
+    hand: Hand,
+    *,
+    segment: str = "auto",
+    mask=None,
+    depth_mode: str = "max",
+    fill_holes: bool = True,
+    approach_offset: float = perception.APPROACH_OFFSET,
+    standoff: float = 0.10,
+    T_base_camera=None,
+    **synthesis_options,
+) -> ImageGraspPlan:
+    """Plan a grasp on one RGB-D frame.
+
+    Parameters
+    ----------
+    rgb : (H, W, 3) uint8 or None
+        Colour image, RGB order, registered to ``depth``.
+    depth : (H, W) float
+        Depth in meters (0 or NaN where missing).
+    intrinsics : Intrinsics
+    hand : Hand
+    segment : {"auto", "rgb", "depth"}
+        Segmentation method (:func:`contourgrasp.perception.segment`); ignored with ``mask``.
+    mask : (H, W) bool, optional
+        The user's own object mask; skips segmentation.
+    depth_mode : {"max", "plane"}
+        Height of the contour's plane (:func:`contourgrasp.perception.contour_to_metric`).
+    fill_holes : bool
+        Fill small depth holes (nearest valid reading) before use.
+    approach_offset : float
+        Added to the nearest depth inside the contour, m.
+    standoff : float
+        Distance of the pre-grasp pose back along the approach axis, m.
+    T_base_camera : (4, 4) float, optional
+        Camera pose in the robot's base frame.
+    **synthesis_options
+        Keyword options of :func:`contourgrasp.synthesis.synthesize`.
+
+    Raises
+    ------
+    InputError
+        Bad images, intrinsics or options; no object found (SegmentationError).
+    NoFeasibleGrasp
+        The object was found but no pose satisfies the constraints.
+    """
+    if segment not in SEGMENT_CHOICES:
+        raise InputError(f"segment must be one of {SEGMENT_CHOICES}, got {segment!r}")
+    if not (math.isfinite(standoff) and standoff >= 0):
+        raise InputError(f"standoff must be a distance >= 0, got {standoff}")
+    d = perception.as_depth(depth)
+    intrinsics.check_shape(d.shape, "depth image")
+    if not perception.valid_depth(d).any():
+        raise InputError("the depth image has no valid reading (all 0, NaN or outside the sensor range)")
+    filled = 0
+    if fill_holes:
+        d, filled = perception.fill_depth_holes(d)
+    if mask is not None:
+        intrinsics.check_shape(np.shape(mask), "mask")
+        seg = perception.segment_from_mask(mask)
+    else:
+        seg = perception.segment(rgb, d, intrinsics, method=segment)
+    metric = perception.contour_to_metric(
+        seg.contour_px, d, intrinsics, depth_mode=depth_mode, plane=seg.plane, offset=approach_offset
+    )
+    plan = synthesize(metric.contour_xy, hand, **synthesis_options)
+    T_camera_hand = hand_pose(metric, plan.pose, metric.approach_depth)
+    T_camera_pregrasp = T_camera_hand.copy()
+    T_camera_pregrasp[:3, 3] -= standoff * T_camera_hand[:3, 2]
+    T_base_hand = None if T_base_camera is None else np.asarray(T_base_camera, dtype=float) @ T_camera_hand
+    return ImageGraspPlan(plan, seg, metric, intrinsics, T_camera_hand, T_camera_pregrasp, T_base_hand, filled)
+
+
+def hand_pose(metric: MetricContour, pose, depth: float) -> np.ndarray:
+    """(4, 4) float: T_camera_hand of a planar pose (x, y, yaw) at ``depth`` along the approach axis."""
+    x, y, yaw = pose
+    c, s = math.cos(yaw), math.sin(yaw)
+    T = np.eye(4)
+    T[:3, :3] = metric.R_camera_plane @ np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    T[:3, 3] = metric.to_camera([[x, y]], depth=depth)[0]
+    return T
+
+
+def project(camera: Intrinsics, points_camera) -> np.ndarray:
+    """(n, 2) float: pixel (u, v) of camera-frame points (n, 3)."""
+    p = np.asarray(points_camera, dtype=float).reshape(-1, 3)
+    return np.c_[camera.fx * p[:, 0] / p[:, 2] + camera.cx, camera.fy * p[:, 1] / p[:, 2] + camera.cy]
