@@ -5,7 +5,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: test demo venv clean
+.PHONY: test demo bench venv clean
 
 venv: $(STAMP)
 
@@ -21,5 +21,10 @@ test: $(STAMP)
 demo: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python tools/demo.py demo-output
 
+# The thesis's grasping experiment (Table 4.4) in simulation: 5 objects x 10 trials x 4 planners.
+bench: $(STAMP)
+	MPLBACKEND=Agg $(BIN)/contourgrasp bench --objects can,case,bottle,stone1,stone2 --trials 10 \
+		--planners paper,default,centroid-principal-axis,random --out bench-output
+
 clean:
-	rm -rf $(VENV) demo-output .pytest_cache
+	rm -rf $(VENV) demo-output bench-output .pytest_cache

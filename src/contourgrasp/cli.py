@@ -10,6 +10,7 @@ import argparse
 import json
 import math
 import sys
+import time
 import warnings
 
 import numpy as np
@@ -42,6 +43,17 @@ def _positive_int(text: str) -> int:
     if value < 1:
         raise argparse.ArgumentTypeError(f"must be a positive integer, got {text}")
     return value
+
+
+def _non_negative_int(text: str) -> int:
+    value = int(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be an integer >= 0, got {text}")
+    return value
+
+
+def _names(text: str) -> list[str]:
+    return [name.strip() for name in text.split(",") if name.strip()]
 
 
 def _contour(spec: str) -> np.ndarray:
@@ -80,6 +92,8 @@ def _parser() -> argparse.ArgumentParser:
     plan.add_argument("--extrinsics", help="T_base_camera (4x4): .npy, .txt, .json, .yaml or autolab .tf")
     _add_synthesis_options(plan)
 
+    _add_bench_parser(sub)
+
     harm = sub.add_parser("efd", help="approximate a contour with several harmonic counts")
     harm.add_argument("--contour", required=True, help=contour_help)
     harm.add_argument("--harmonics", type=_positive_int, nargs="+", default=[1, 2, 4, 8])
@@ -100,6 +114,22 @@ def _add_synthesis_options(parser) -> None:
     parser.add_argument("--top-k", type=_positive_int, default=10, help="ranked distinct poses to report")
     parser.add_argument("--out", help="write the plan JSON here (default: print it)")
     parser.add_argument("--plot", help="write the plan picture (PNG) here")
+
+
+def _add_bench_parser(sub) -> None:
+    bench = sub.add_parser("bench", help="simulated grasping experiment (thesis Table 4.4): objects x trials x planners")
+    objects = bench.add_mutually_exclusive_group()
+    objects.add_argument("--objects", default="can,case,bottle,stone1,stone2",
+                         help="comma-separated names of the simulated objects (default: the thesis's five)")
+    objects.add_argument("--mesh", nargs="+", metavar="FILE", help="OBJ/STL mesh files in meters, z up, instead")
+    bench.add_argument("--trials", type=_positive_int, default=10, help="trials per object and planner")
+    bench.add_argument("--seed", type=_non_negative_int, default=0, help="trial t uses seed SEED + t")
+    bench.add_argument("--hand", default="five-finger-linear", help="preset name or hand TOML file (ray fingers)")
+    bench.add_argument("--planners", default="paper,default,centroid-principal-axis,random",
+                       help="comma-separated planner names")
+    bench.add_argument("--out", default="bench-output", help="output folder (created if missing)")
+    bench.add_argument("--noise", action=argparse.BooleanOptionalAction, default=True,
+                       help="depth sensor noise in the planner's picture")
 
 
 def _synthesis_options(args) -> dict:
@@ -185,6 +215,21 @@ def _plan(args) -> int:
     return EXIT_OK
 
 
+def _bench(args) -> int:
+    from .sim import bench, mesh_object
+
+    started = time.perf_counter()
+    objects = [mesh_object(path) for path in args.mesh] if args.mesh else bench.thesis_objects(_names(args.objects))
+    setup = bench.Bench(objects=objects, planners=_names(args.planners), trials=args.trials, seed=args.seed,
+                        hand=load_hand(args.hand), noise=args.noise)
+    with bench.console_progress(setup.size) as progress:
+        results = bench.run_bench(setup, progress)
+    paths = bench.write_outputs(setup, results, args.out, wall_time=time.perf_counter() - started)
+    print("\n".join(bench.rates_table(setup, results)))
+    print(f"{len(results)} trials in {time.perf_counter() - started:.0f} s -> {', '.join(map(str, paths))}")
+    return EXIT_OK
+
+
 def _efd(args) -> int:
     contour = efd.clean_polygon(_contour(args.contour))
     for k in args.harmonics:
@@ -201,7 +246,7 @@ def _efd(args) -> int:
     return EXIT_OK
 
 
-COMMANDS = {"hands": _hands, "synth": _synth, "plan": _plan, "efd": _efd}
+COMMANDS = {"hands": _hands, "synth": _synth, "plan": _plan, "bench": _bench, "efd": _efd}
 
 
 def main(argv=None) -> int:

@@ -1,12 +1,12 @@
-"""Scene and rendering: geometry of the top-down camera, noise, the test planner on a rendered can."""
+"""Scene and rendering: geometry of the top-down camera, noise, plan_grasp on a rendered can."""
 
 import numpy as np
 import pytest
 
 import contourgrasp
-from contourgrasp.sim import Camera, DepthNoise, build_scene, hand_pose_from_matrix, render
+from contourgrasp.sim import Camera, DepthNoise, build_scene, hand_pose_from_matrix, render, render_view
+from contourgrasp.sim.planners import make_planner
 from contourgrasp.sim.scene import Workspace
-from sim_planner import depth_planner
 
 
 @pytest.fixture(scope="module")
@@ -32,6 +32,14 @@ def test_object_top_depth(can_scene):
     _, depth = render(can_scene)
     # A can lying on its side: its top is 0.066 m above the table.
     assert abs(depth[depth > 0].min() - (can_scene.camera.height - 0.066)) < 1e-3
+
+
+def test_side_view_sees_the_object_over_the_table(can_scene):
+    target = can_scene.object_com()
+    rgb, hit = render_view(can_scene, target + [0.0, -0.5, 0.2], target, show_hand=False)
+    assert rgb.shape == (*hit.shape, 3) and hit[-1].all() and not hit[0].any()  # table below, nothing above
+    red = (rgb[..., 0] > 100) & (rgb[..., 1] < 60)
+    assert red[rgb.shape[0] // 2 - 10: rgb.shape[0] // 2 + 10, rgb.shape[1] // 2].any()  # the can, in the middle
 
 
 def test_depth_outside_the_sensor_range_is_missing():
@@ -63,9 +71,9 @@ def test_placement_is_seeded_and_inside_the_workspace():
 
 def test_planner_finds_the_can(can_scene):
     rgb, depth = render(can_scene, noise=True, seed=1)
-    transform, approach = depth_planner(rgb, depth, can_scene.camera.intrinsics)
-    x, y, yaw = hand_pose_from_matrix(transform)
     hand = contourgrasp.load_hand("five-finger-linear")
+    transform, approach = make_planner("paper", hand)(rgb, depth, can_scene.camera.intrinsics)
+    x, y, yaw = hand_pose_from_matrix(transform)
     grasp_centre = contourgrasp.hand.to_image(hand.grasp_centre[None], (x, y, yaw))[0]
     can_centre = can_scene.camera.from_world(can_scene.object_com())[:2]
     assert np.linalg.norm(grasp_centre - can_centre) < 0.04

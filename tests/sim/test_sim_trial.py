@@ -3,11 +3,13 @@
 import numpy as np
 import pytest
 
-from contourgrasp import InputError, NoFeasibleGrasp
+from contourgrasp import InputError, NoFeasibleGrasp, load_hand
 from contourgrasp.sim import (FAILURE_CAUSES, Camera, ObjectSpec, Part, Workspace, build_scene, execute_grasp,
                               pose_matrix, run_trial)
+from contourgrasp.sim.planners import make_planner
 from contourgrasp.sim.trial import NO_PLAN, STRUCK, scripted_grasp
-from sim_planner import depth_planner
+
+PAPER = make_planner("paper", load_hand("five-finger-linear"))
 
 
 def test_scripted_good_grasp_lifts_the_can():
@@ -34,8 +36,8 @@ def test_descending_onto_the_object_is_a_strike():
     assert outcome.cause == STRUCK and not outcome.success
 
 
-def test_trial_with_the_test_planner_lifts_the_can():
-    record = run_trial("can", seed=0, planner=depth_planner)
+def test_trial_with_the_paper_planner_lifts_the_can():
+    record = run_trial("can", seed=1, planner=PAPER)
     print("\n", record)
     assert record.success, record
     assert len(record.fingers_in_contact) >= 4
@@ -49,22 +51,25 @@ def test_too_large_object_is_no_feasible_plan():
     # discs still let the fingers hook its rim.)
     platter = ObjectSpec("platter", (Part("cylinder", (0.40, 0.01), pos=(0.0, 0.0, 0.01)),), mass=3.0,
                          friction_hand=0.6, friction_table=0.4)
-    record = run_trial(platter, seed=0, planner=depth_planner, workspace=Workspace(0.0, 0.0),
+    record = run_trial(platter, seed=0, planner=PAPER, workspace=Workspace(0.0, 0.0),
                        camera=Camera(height=1.0))
     assert not record.success and record.cause == NO_PLAN
     assert record.pose is None and record.fingers_in_contact == ()
 
 
-def test_planner_raising_no_feasible_grasp_is_recorded():
+@pytest.mark.parametrize("error", [NoFeasibleGrasp("nothing"), InputError("nothing")])
+def test_planner_without_a_plan_is_recorded(error):
     def planner(rgb, depth, intrinsics):
-        raise NoFeasibleGrasp("nothing")
-    record = run_trial("case", seed=1, planner=planner)
-    assert record.cause == NO_PLAN
+        raise error
+    ended = []
+    record = run_trial("case", seed=1, planner=planner, observe=ended.append)
+    assert record.cause == NO_PLAN and record.plan_error == "nothing" and record.plan_time >= 0
+    assert len(ended) == 1
 
 
 def test_same_seed_same_record():
-    first = run_trial("bottle", seed=2, planner=depth_planner)
-    second = run_trial("bottle", seed=2, planner=depth_planner)
+    first = run_trial("bottle", seed=2, planner=PAPER)
+    second = run_trial("bottle", seed=2, planner=PAPER)
     assert first == second
     assert first.wall_time != second.wall_time or first.wall_time > 0
 

@@ -6,6 +6,8 @@
 * :mod:`~contourgrasp.sim.render` -- RGB-D pictures by ray casting
 * :mod:`~contourgrasp.sim.trial` -- grasp execution and trials
 * :mod:`~contourgrasp.sim.measure` -- fingertip paths against the preset
+* :mod:`~contourgrasp.sim.planners` -- the library's pipeline as trial planners, and two baselines
+* :mod:`~contourgrasp.sim.bench` -- Table 4.4 as a benchmark (``contourgrasp bench``), with its figures
 
 Needs ``mujoco`` (4.x: ``mj_multiRay`` takes a ``normal`` argument), ``trimesh``
 and ``coacd``; nothing here uses OpenGL (``MUJOCO_GL`` defaults to ``disable``).
@@ -20,7 +22,7 @@ Example::
 from .hand_model import TIMINGS, FingerTiming, HandDesign, HandModel, build_hand
 from .measure import fingertip_path_error, fingertip_paths
 from .objects import THESIS_OBJECTS, ObjectSpec, Part, mesh_object, object_spec
-from .render import DepthNoise, render
+from .render import DepthNoise, render, render_view
 from .scene import Camera, Intrinsics, Placement, Scene, Workspace, build_scene
 from .trial import (DROPPED, FAILURE_CAUSES, NO_PLAN, PUSHED, SLIPPED, STRUCK, Execution, GraspOutcome, TrialRecord,
                     execute_grasp, hand_pose_from_matrix, pose_matrix, run_trial, scripted_grasp)
@@ -30,5 +32,5 @@ __all__ = [
     "HandModel", "Intrinsics", "NO_PLAN", "ObjectSpec", "PUSHED", "Part", "Placement", "SLIPPED", "STRUCK", "Scene",
     "THESIS_OBJECTS", "TIMINGS", "TrialRecord", "Workspace", "build_hand", "build_scene", "execute_grasp",
     "fingertip_path_error", "fingertip_paths", "hand_pose_from_matrix", "mesh_object", "object_spec", "pose_matrix",
-    "render", "run_trial", "scripted_grasp",
+    "render", "render_view", "run_trial", "scripted_grasp",
 ]

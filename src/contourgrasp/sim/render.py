@@ -1,4 +1,4 @@
-"""RGB-D images of a scene by ray casting (no OpenGL needed).
+"""RGB-D images of a scene by ray casting (no OpenGL needed): the camera's picture, and views for figures.
 
 One ray per pixel centre leaves the optical centre (``mujoco.mj_multiRay``);
 the hit distance along a ray whose camera-frame direction has unit z is the
@@ -18,11 +18,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .scene import R_WORLD_CAMERA, Scene, mujoco
+from .scene import R_WORLD_CAMERA, Intrinsics, Scene, mujoco
 
 #: Geom groups the camera sees: table and objects (0) and objects' drawn meshes (1), not the hand (2)
 #: nor collision-only pieces (3).
 SCENE_GROUPS = (0, 1)
+#: A small camera for :func:`render_view` (320 x 240, ~56 x 43 degrees).
+VIEW_INTRINSICS = Intrinsics(fx=300.0, fy=300.0, cx=159.5, cy=119.5, width=320, height=240)
+#: Farthest hit :func:`render_view` looks for, m.
+VIEW_RANGE = 5.0
 
 
 @dataclass(frozen=True)
@@ -65,25 +69,55 @@ def render(scene: Scene, *, noise: DepthNoise | bool = False, seed: int = 0,
         Meters along the optical axis; 0 where nothing is hit or out of range.
     """
     intr = scene.camera.intrinsics
-    rays_camera = intr.rays().reshape(-1, 3)
-    rays_world = np.ascontiguousarray(rays_camera @ R_WORLD_CAMERA.T)
+    rgb, depth = _cast(scene, scene.camera.position, R_WORLD_CAMERA, intr, show_hand, 2 * intr.depth_max)
+    if noise:
+        depth = _noisy(depth, DepthNoise() if noise is True else noise, np.random.default_rng([seed, 1]))
+    depth = np.where((depth >= intr.depth_min) & (depth <= intr.depth_max), depth, 0.0)
+    return rgb, depth.astype(np.float32)
+
+
+def render_view(scene: Scene, eye, target, intrinsics: Intrinsics = VIEW_INTRINSICS, *,
+                show_hand: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """Render the scene from any viewpoint, for figures (e.g. the hand holding the object, seen from the side).
+
+    Parameters
+    ----------
+    scene : Scene
+    eye, target : (3,) float
+        The pinhole's position and the point it looks at, world frame; image up is world z.
+    intrinsics : Intrinsics
+    show_hand : bool
+
+    Returns
+    -------
+    rgb : (H, W, 3) uint8
+        Black where the ray hits nothing.
+    hit : (H, W) bool
+    """
+    eye, target = np.asarray(eye, dtype=float), np.asarray(target, dtype=float)
+    forward = (target - eye) / np.linalg.norm(target - eye)
+    right = np.cross(forward, [0.0, 0.0, 1.0])
+    right /= np.linalg.norm(right)
+    rotation = np.column_stack([right, np.cross(forward, right), forward])  # optical frame: x right, y down
+    rgb, depth = _cast(scene, eye, rotation, intrinsics, show_hand, VIEW_RANGE)
+    return rgb, depth > 0
+
+
+def _cast(scene: Scene, eye, R_world_camera, intr: Intrinsics, show_hand: bool, max_distance: float):
+    """Colour (H, W, 3) uint8 and depth along the optical axis (H, W) float (0: no hit) by one ray per pixel."""
+    rays_world = np.ascontiguousarray(intr.rays().reshape(-1, 3) @ np.asarray(R_world_camera).T)
     n = len(rays_world)
     geom = np.empty(n, dtype=np.int32)
     dist = np.empty(n, dtype=np.float64)
     normal = np.empty((n, 3), dtype=np.float64)
     groups = np.zeros(6, dtype=np.uint8)
     groups[list(SCENE_GROUPS) + ([2] if show_hand else [])] = 1
-    mujoco.mj_multiRay(scene.model, scene.data, scene.camera.position, rays_world.ravel(), groups, 1, -1,
-                       geom, dist, normal.ravel(), n, 2 * intr.depth_max)
+    mujoco.mj_multiRay(scene.model, scene.data, np.asarray(eye, dtype=float), rays_world.ravel(), groups, 1, -1,
+                       geom, dist, normal.ravel(), n, max_distance)
     hit = geom >= 0
-    depth = np.where(hit, dist, 0.0)
     rgb = _shade(scene.model.geom_rgba[geom, :3], normal, rays_world, hit)
     shape = (intr.height, intr.width)
-    depth = depth.reshape(shape)
-    if noise:
-        depth = _noisy(depth, DepthNoise() if noise is True else noise, np.random.default_rng([seed, 1]))
-    depth = np.where((depth >= intr.depth_min) & (depth <= intr.depth_max), depth, 0.0)
-    return rgb.reshape(*shape, 3), depth.astype(np.float32)
+    return rgb.reshape(*shape, 3), np.where(hit, dist, 0.0).reshape(shape)
 
 
 def _shade(colour: np.ndarray, normal: np.ndarray, rays: np.ndarray, hit: np.ndarray) -> np.ndarray:

@@ -26,7 +26,9 @@ raises a lying object a few millimetres) and moved less than
 
 Failure causes (chapter 5), first that applies:
 
-* ``"no feasible plan"`` -- the planner raised :class:`~contourgrasp.errors.NoFeasibleGrasp`;
+* ``"no feasible plan"`` -- the planner raised :class:`~contourgrasp.errors.NoFeasibleGrasp`
+  or :class:`~contourgrasp.errors.InputError` (e.g. perception found no object
+  wholly in view); the record keeps its message;
 * ``"a finger struck the object while descending"`` -- any hand-object contact
   before closing; the execution stops there, as a robot with a force sensor would;
 * ``"object pushed away before all fingers touched"`` -- the object had moved
@@ -120,7 +122,7 @@ class GraspOutcome:
 class TrialRecord:
     """One grasping trial: the scene's seed, the plan, and its outcome.
 
-    Equal records mean the same trial; ``wall_time`` is left out of the comparison.
+    Equal records mean the same trial; ``plan_time`` and ``wall_time`` are left out of the comparison.
 
     Attributes
     ----------
@@ -136,8 +138,12 @@ class TrialRecord:
     pose : (3,) float or None
         Planned hand pose (x, y, yaw), image plane; None without a plan.
     approach_depth : float or None
+    plan_error : str or None
+        Why the planner gave no plan (its exception's message); None with a plan.
     sim_time : float
         Simulated seconds, settling included.
+    plan_time : float
+        Seconds of wall time the planner took (left out of the comparison).
     wall_time : float
         Seconds of wall time for the whole trial (scene, picture, plan, simulation).
     """
@@ -153,13 +159,15 @@ class TrialRecord:
     hold_drift: float
     pose: tuple[float, float, float] | None
     approach_depth: float | None
+    plan_error: str | None
     sim_time: float
+    plan_time: float = field(compare=False)
     wall_time: float = field(compare=False)
 
 
 def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finger-linear", noise=True,
               timing: str = "thesis", design: HandDesign = HandDesign(), camera: Camera = Camera(),
-              workspace: Workspace = Workspace(), execution: Execution = Execution()) -> TrialRecord:
+              workspace: Workspace = Workspace(), execution: Execution = Execution(), observe=None) -> TrialRecord:
     """Place the object (seeded), take an RGB-D picture, plan, execute, and record the outcome.
 
     Parameters
@@ -173,7 +181,8 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
         ``rgb`` (H, W, 3) uint8, ``depth`` (H, W) float32 m (0 = missing),
         ``intrinsics`` :class:`~contourgrasp.sim.scene.Intrinsics`; returns the
         (4, 4) hand pose in the camera frame (see :func:`hand_pose_from_matrix`)
-        and the approach depth (m). It may raise ``NoFeasibleGrasp``.
+        and the approach depth (m). It may raise ``NoFeasibleGrasp`` or
+        ``InputError`` when it has no plan.
     hand : Hand or str
         The hand preset the simulated hand is built from.
     noise : DepthNoise or bool
@@ -182,22 +191,31 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
         Finger closing schedule and hand parameters (:mod:`contourgrasp.sim.hand_model`).
     camera, workspace, execution
         Scene and execution parameters.
+    observe : callable, optional
+        ``observe(scene)`` is called when the trial ends (after the hold, an
+        aborted descent, or the picture when there is no plan), e.g. to render it.
     """
     started = time.perf_counter()
     scene = build_scene(object_spec, seed=seed, hand=hand, design=design, timing=timing, camera=camera,
                         workspace=workspace)
     rgb, depth = render(scene, noise=noise, seed=seed)
-    common = {"object": scene.object.name, "seed": seed}
+    planning = time.perf_counter()
     try:
         transform, approach_depth = planner(rgb, depth, camera.intrinsics)
-    except NoFeasibleGrasp:
-        return TrialRecord(**common, success=False, cause=NO_PLAN, fingers_in_contact=(), first_contact=(),
-                           push=0.0, lift=0.0, hold_drift=0.0, pose=None, approach_depth=None,
-                           sim_time=scene.time, wall_time=time.perf_counter() - started)
-    outcome = execute_grasp(scene, transform, approach_depth, execution)
-    fields = {k: v for k, v in asdict(outcome).items() if k != "palm_depth"}
-    return TrialRecord(**common, **fields, approach_depth=float(approach_depth), sim_time=scene.time,
-                       wall_time=time.perf_counter() - started)
+        plan_error = None
+    except (NoFeasibleGrasp, InputError) as err:
+        plan_error = str(err)
+    plan_time = time.perf_counter() - planning
+    if plan_error is None:
+        outcome = asdict(execute_grasp(scene, transform, approach_depth, execution))
+        fields = {k: v for k, v in outcome.items() if k != "palm_depth"} | {"approach_depth": float(approach_depth)}
+    else:
+        fields = {"success": False, "cause": NO_PLAN, "fingers_in_contact": (), "first_contact": (), "push": 0.0,
+                  "lift": 0.0, "hold_drift": 0.0, "pose": None, "approach_depth": None}
+    if observe is not None:
+        observe(scene)
+    return TrialRecord(object=scene.object.name, seed=seed, **fields, plan_error=plan_error, sim_time=scene.time,
+                       plan_time=plan_time, wall_time=time.perf_counter() - started)
 
 
 def hand_pose_from_matrix(transform) -> tuple[float, float, float]:

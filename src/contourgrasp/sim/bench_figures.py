@@ -1,0 +1,105 @@
+"""Figures of the bench (:mod:`contourgrasp.sim.bench`): success rates, and a few trials in pictures.
+
+Matplotlib ``Figure`` objects built without pyplot, like :mod:`contourgrasp.visualize`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from ..hand import to_image
+from ..pipeline import project
+from ..visualize import FINGER_COLOURS
+from .bench import SHORT_CAUSES, Bench, label, success_rates, thesis_rates
+
+#: Pixels around the object and the open hand in the camera panels.
+CROP_MARGIN = 30
+THESIS_COLOUR = "0.75"
+PLANNER_COLOURS = ("tab:blue", "tab:green", "tab:orange", "tab:red", "tab:purple", "tab:brown", "tab:pink")
+
+
+def success_figure(bench: Bench, results) -> Figure:
+    """Success rate per object (groups) and planner (bars), Table 4.4's rate first where it has one."""
+    objects = [o.name for o in bench.objects]
+    series = [("thesis (Table 4.4, real robot)", thesis_rates(objects), THESIS_COLOUR)]
+    series += [(p, success_rates(results, p, objects), PLANNER_COLOURS[i % len(PLANNER_COLOURS)])
+               for i, p in enumerate(bench.planners)]
+    groups = [*objects, "all"]
+    width = 0.8 / len(series)
+    fig = Figure(figsize=(max(8.0, 1.9 * len(groups) + 2), 4.6), layout="constrained")
+    ax = fig.add_subplot()
+    for k, (name, rates, colour) in enumerate(series):
+        x = np.arange(len(groups)) + (k - (len(series) - 1) / 2) * width
+        heights = [100 * (rates[g] if rates[g] is not None else np.nan) for g in groups]
+        bars = ax.bar(x, heights, width, label=name, color=colour, edgecolor="black", linewidth=0.5,
+                      hatch="//" if k == 0 else None)
+        ax.bar_label(bars, fmt="%.0f", fontsize=7, padding=1)
+    ax.set_xticks(np.arange(len(groups)), [label(g) for g in groups])
+    ax.set_ylim(0, 110)
+    ax.set_ylabel("success rate [%]")
+    ax.set_title(f"Grasp success: {bench.trials} simulated trial(s) per object and planner,\n"
+                 f"hand {bench.hand.name}; the thesis's rates from a real robot", fontsize=10)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    ax.grid(axis="y", alpha=0.3)
+    return fig
+
+
+def trials_figure(bench: Bench, snapshots) -> Figure:
+    """A row per planner, its snapshots side by side: the camera's picture with the plan, the end from the side."""
+    planners = list(dict.fromkeys(snap.result.planner for snap in snapshots)) or [None]
+    per_row = max([sum(snap.result.planner == p for snap in snapshots) for p in planners] + [1])
+    fig = Figure(figsize=(8.5 * per_row, 3.4 * len(planners)), layout="constrained")
+    axes = fig.subplots(len(planners), 2 * per_row, squeeze=False, width_ratios=[1, 1.25] * per_row)
+    for row, planner in zip(axes, planners):
+        own = [snap for snap in snapshots if snap.result.planner == planner]
+        for k, snap in enumerate(own):
+            draw_camera_panel(row[2 * k], snap, bench.hand)
+            draw_side_panel(row[2 * k + 1], snap)
+    if not snapshots:
+        axes[0, 0].text(0.5, 0.5, "no trial had a plan", ha="center", va="center")
+    for ax in axes.ravel():
+        ax.set_axis_off()
+    return fig
+
+
+def draw_camera_panel(ax, snap, hand) -> None:
+    """The planner's picture, cropped, with the object's contour and the hand's finger paths at the plan."""
+    planned = snap.planned
+    contour = np.vstack([planned.segmentation.contour_px, planned.segmentation.contour_px[:1]])
+    ax.imshow(snap.rgb)
+    ax.plot(*contour.T, color="yellow", lw=1.0)
+    starts = []
+    for i, finger in enumerate(hand.fingers):
+        colour = FINGER_COLOURS[i % len(FINGER_COLOURS)]
+        path = _pixels(planned, to_image(finger.points(np.linspace(0.0, finger.travel, 20)), planned.pose))
+        ax.plot(*path.T, color=colour, lw=1.4)
+        ax.plot(*path[0], "o", color=colour, mfc="white", ms=4)
+        starts.append(path[0])
+    if planned.plan is not None:
+        for i, contact in enumerate(planned.plan.fingers):
+            point = _pixels(planned, [contact.grasp_point])[0]
+            ax.plot(*point, "X" if contact.missed else "*", color=FINGER_COLOURS[i % len(FINGER_COLOURS)], ms=9,
+                    mec="black", mew=0.5)
+    seen = np.vstack([contour, starts])
+    low, high = seen.min(axis=0) - CROP_MARGIN, seen.max(axis=0) + CROP_MARGIN
+    height, width = snap.rgb.shape[:2]
+    ax.set_xlim(max(low[0], 0), min(high[0], width))
+    ax.set_ylim(min(high[1], height), max(low[1], 0))
+    result = snap.result
+    ax.set_title(f"{result.planner}: {label(result.record.object)}, trial {result.trial + 1} (seed "
+                 f"{result.record.seed})", fontsize=9)
+
+
+def draw_side_panel(ax, snap) -> None:
+    """The scene at the end of the trial from the side (white where nothing is seen), with the outcome."""
+    ax.imshow(np.where(snap.hit[..., None], snap.view, 255).astype(np.uint8))
+    record = snap.result.record
+    outcome = "held" if record.success else f"failed: {SHORT_CAUSES[record.cause]}"
+    ax.set_title(f"{outcome}; lifted {100 * record.lift:.1f} cm, moved {1000 * record.hold_drift:.0f} mm in the "
+                 f"hand; touching: {', '.join(record.fingers_in_contact) or 'none'}", fontsize=8)
+
+
+def _pixels(planned, points_xy) -> np.ndarray:
+    """(n, 2) float: pixels of planning-frame points (n, 2) in the contour's plane."""
+    return project(planned.camera, planned.metric.to_camera(points_xy))

@@ -1,0 +1,256 @@
+"""Planners for simulated trials: the library's pipeline under named settings, and two baselines.
+
+A planner is what :func:`~contourgrasp.sim.trial.run_trial` calls:
+``planner(rgb, depth, intrinsics) -> (T_camera_hand, approach_depth)``, raising
+:class:`~contourgrasp.errors.NoFeasibleGrasp` or
+:class:`~contourgrasp.errors.InputError` when it has no plan. Every planner
+here also has ``plan(rgb, depth, intrinsics) -> PlannedGrasp``, the same
+answer with what it saw (for figures).
+
+Synthesis planners (:data:`SYNTHESIS_PLANNERS`, name -> keyword options)
+    :func:`contourgrasp.pipeline.plan_grasp` -- exactly the path a user's camera
+    frames take -- with the given options; ``{}`` means the library's defaults.
+    Add an entry to compare another setting.
+
+Baselines (:data:`BASELINES`), to show whether the bench tells good from bad
+    Both use the same perception as ``plan_grasp`` (:func:`perceive`) and no synthesis.
+
+    ``centroid-principal-axis``
+        The hand's grasp centre (:attr:`~contourgrasp.hand.Hand.grasp_centre`,
+        the mean closed fingertip) on the contour's centroid, the thumb
+        closing along the contour's minor principal axis, i.e. across the
+        object's narrow side (the other fingers of the Table 4.3 hand, closing
+        at right angles to the thumb, then close along its length). Of the
+        minor axis's two directions the one with positive image y is taken.
+    ``random``
+        A pose drawn uniformly from the ``paper`` planner's whole search region
+        (the grid's x and y extent around the EFD locus, any yaw) among the poses
+        that satisfy the synthesis constraints
+        (:func:`~contourgrasp.synthesis.evaluate_poses`), by rejection
+        sampling seeded with the trial seed.
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from .. import efd, perception, pipeline, synthesis
+from ..errors import InputError, NoFeasibleGrasp
+from ..hand import Hand, Ray, to_image
+
+#: Synthesis planners: name -> options of :func:`contourgrasp.pipeline.plan_grasp` (``{}``: the library's defaults).
+SYNTHESIS_PLANNERS: dict[str, dict] = {
+    # Thesis: Tables 4.1-4.2 grid, 4 harmonics (4.2.1), curvature as printed, contour plane at the
+    # largest contour depth (eq 3.1-3.2); the gains are the hand's (Table 4.3 for five-finger-linear).
+    "paper": {"harmonics": 4, "curvature": "paper", "xy_step": 0.05, "yaw_step": math.radians(2.0),
+              "d_max": (0.15, 0.15), "d_min": 0.015, "depth_mode": "max"},
+    "default": {},
+}
+#: Baseline planners without synthesis: name -> what it does (module docstring).
+BASELINES = {
+    "centroid-principal-axis": "the hand's grasp centre on the contour's centroid, the thumb closing along its "
+                               "minor axis; same perception, no synthesis",
+    "random": "a pose drawn uniformly among the feasible poses of `paper`'s whole search region; "
+              "same perception, no synthesis",
+}
+#: Every planner name :func:`make_planner` knows.
+PLANNER_NAMES = (*SYNTHESIS_PLANNERS, *BASELINES)
+#: The settings whose search region and constraints the random baseline uses.
+RANDOM_REGION = "paper"
+#: Random poses drawn per batch, and batches tried before giving up.
+RANDOM_BATCH, RANDOM_BATCHES = 2048, 32
+
+
+@dataclass(frozen=True, eq=False)
+class PlannedGrasp:
+    """A planner's answer and what it saw.
+
+    Attributes
+    ----------
+    pose : (3,) float
+        (x, y, yaw) of the hand in the planning frame of ``metric``.
+    T_camera_hand : (4, 4) float
+    approach_depth : float
+    segmentation : Segmentation
+    metric : MetricContour
+    camera : contourgrasp.perception.Intrinsics
+    plan : GraspPlan or None
+        The synthesis result (None for a baseline).
+    """
+
+    pose: np.ndarray
+    T_camera_hand: np.ndarray
+    approach_depth: float
+    segmentation: perception.Segmentation
+    metric: perception.MetricContour
+    camera: perception.Intrinsics
+    plan: synthesis.GraspPlan | None
+
+
+def camera_intrinsics(intrinsics) -> perception.Intrinsics:
+    """The library's intrinsics of the simulated camera's (its depth range is applied by the renderer)."""
+    return perception.Intrinsics(intrinsics.fx, intrinsics.fy, intrinsics.cx, intrinsics.cy, intrinsics.width,
+                                 intrinsics.height)
+
+
+@dataclass(frozen=True)
+class _Planner:
+    """Base of the planners: ``__call__`` is the trial's planner interface over the subclass's ``plan``."""
+
+    hand: Hand
+
+    def __call__(self, rgb, depth, intrinsics):
+        planned = self.plan(rgb, depth, intrinsics)
+        return planned.T_camera_hand, planned.approach_depth
+
+
+@dataclass(frozen=True)
+class SynthesisPlanner(_Planner):
+    """:func:`contourgrasp.pipeline.plan_grasp` with fixed options ((name, value) pairs)."""
+
+    options: tuple[tuple[str, object], ...] = ()
+
+    def plan(self, rgb, depth, intrinsics) -> PlannedGrasp:
+        result = pipeline.plan_grasp(rgb, depth, camera_intrinsics(intrinsics), self.hand, **dict(self.options))
+        return PlannedGrasp(result.plan.pose, result.T_camera_hand, result.metric.approach_depth,
+                            result.segmentation, result.metric, result.camera, result.plan)
+
+
+@dataclass(frozen=True)
+class CentroidPlanner(_Planner):
+    """The ``centroid-principal-axis`` baseline (module docstring)."""
+
+    def plan(self, rgb, depth, intrinsics) -> PlannedGrasp:
+        camera = camera_intrinsics(intrinsics)
+        segmentation, metric = perceive(rgb, depth, camera)
+        return _planned(centroid_pose(metric.contour_xy, self.hand), segmentation, metric, camera)
+
+
+@dataclass(frozen=True)
+class RandomPlanner(_Planner):
+    """The ``random`` baseline (module docstring), seeded by the trial seed."""
+
+    seed: int = 0
+
+    def plan(self, rgb, depth, intrinsics) -> PlannedGrasp:
+        camera = camera_intrinsics(intrinsics)
+        segmentation, metric = perceive(rgb, depth, camera)
+        rng = np.random.default_rng([self.seed, 2])  # streams 0 and 1 place the object and add noise
+        pose = random_feasible_pose(metric.contour_xy, self.hand, rng, search_settings(RANDOM_REGION))
+        return _planned(pose, segmentation, metric, camera)
+
+
+def make_planner(name: str, hand: Hand, *, seed: int = 0) -> _Planner:
+    """The planner called ``name`` (one of :data:`PLANNER_NAMES`) for ``hand``; ``seed`` seeds ``random``.
+
+    Raises
+    ------
+    InputError
+        Unknown name.
+    """
+    if name in SYNTHESIS_PLANNERS:
+        return SynthesisPlanner(hand, tuple(SYNTHESIS_PLANNERS[name].items()))
+    if name == "centroid-principal-axis":
+        return CentroidPlanner(hand)
+    if name == "random":
+        return RandomPlanner(hand, seed)
+    raise InputError(f"unknown planner {name!r}: choose from {', '.join(PLANNER_NAMES)}")
+
+
+def library_defaults(names) -> dict:
+    """The defaults of the options ``names`` of :func:`contourgrasp.pipeline.plan_grasp` and of synthesis."""
+    defaults = {}
+    for function in (pipeline.plan_grasp, synthesis.synthesize):
+        for name, parameter in inspect.signature(function).parameters.items():
+            if name in names and parameter.default is not inspect.Parameter.empty:
+                defaults[name] = parameter.default
+    return defaults
+
+
+def search_settings(name: str) -> dict:
+    """Harmonics, curvature and the :class:`~contourgrasp.synthesis.SearchGrid` synthesis planner ``name`` uses."""
+    keys = ("harmonics", "curvature", "xy_step", "yaw_step", "d_max", "d_min")
+    options = library_defaults(keys) | {k: v for k, v in SYNTHESIS_PLANNERS[name].items() if k in keys}
+    grid = synthesis.SearchGrid(**{k: options[k] for k in ("xy_step", "yaw_step", "d_max", "d_min")})
+    return {"harmonics": options["harmonics"], "curvature": options["curvature"], "grid": grid}
+
+
+def perceive(rgb, depth, intrinsics: perception.Intrinsics):
+    """The perception of :func:`contourgrasp.pipeline.plan_grasp` with its defaults: (Segmentation, MetricContour).
+
+    The same steps: check the depth, fill small holes, segment (``"auto"``),
+    contour to meters (``"max"`` plane, the default approach offset).
+
+    Raises
+    ------
+    InputError
+        No valid depth, no object found (SegmentationError), no depth on the contour.
+    """
+    d = perception.as_depth(depth)
+    intrinsics.check_shape(d.shape, "depth image")
+    if not perception.valid_depth(d).any():
+        raise InputError("the depth image has no valid reading (all 0, NaN or outside the sensor range)")
+    d, _ = perception.fill_depth_holes(d)
+    segmentation = perception.segment(rgb, d, intrinsics)
+    return segmentation, perception.contour_to_metric(segmentation.contour_px, d, intrinsics,
+                                                      plane=segmentation.plane)
+
+
+def centroid_pose(contour_xy, hand: Hand) -> np.ndarray:
+    """(3,) float: the pose putting ``hand.grasp_centre`` on the polygon's centroid, thumb along its minor axis."""
+    moments = cv2.moments(np.asarray(contour_xy, dtype=np.float32))
+    if moments["m00"] == 0:
+        raise InputError("the contour encloses no area")
+    centroid = np.array([moments["m10"], moments["m01"]]) / moments["m00"]
+    covariance = np.array([[moments["mu20"], moments["mu11"]], [moments["mu11"], moments["mu02"]]])
+    minor = np.linalg.eigh(covariance)[1][:, 0]  # eigenvalues ascending
+    minor = minor if minor[1] >= 0 else -minor
+    thumb = _thumb_direction(hand)
+    yaw = (math.atan2(minor[1], minor[0]) - math.atan2(thumb[1], thumb[0])) % (2 * math.pi)
+    x, y = centroid - to_image(hand.grasp_centre[None], (0.0, 0.0, yaw))[0]
+    return np.array([x, y, yaw])
+
+
+def _thumb_direction(hand: Hand) -> tuple[float, float]:
+    """Closing direction of the first required finger (the thumb), else of the first finger."""
+    finger = next((f for f in hand.fingers if f.required), hand.fingers[0])
+    if not isinstance(finger.trajectory, Ray):
+        raise InputError(f"hand {hand.name!r}: the centroid baseline needs a thumb that closes on a ray")
+    return finger.trajectory.closing_direction
+
+
+def random_feasible_pose(contour_xy, hand: Hand, rng: np.random.Generator, settings: dict) -> np.ndarray:
+    """(3,) float: a pose uniform over the search region's feasible poses (rejection sampling).
+
+    ``settings`` is :func:`search_settings`'s: the region is the grid's x and y
+    extent around the EFD locus (as :func:`~contourgrasp.synthesis.synthesize`
+    would search it) and any yaw; feasibility is
+    :func:`~contourgrasp.synthesis.evaluate_poses`'s with the grid's D_min.
+
+    Raises
+    ------
+    NoFeasibleGrasp
+        None of ``RANDOM_BATCH * RANDOM_BATCHES`` poses drawn is feasible.
+    """
+    model = efd.fit(efd.clean_polygon(contour_xy), settings["harmonics"], validate=False)
+    grid = settings["grid"]
+    xs, ys, _ = grid.axes(model.locus)
+    low, high = np.array([xs[0], ys[0], 0.0]), np.array([xs[-1], ys[-1], 2 * math.pi])
+    for _ in range(RANDOM_BATCHES):
+        poses = rng.uniform(low, high, size=(RANDOM_BATCH, 3))
+        feasible = synthesis.evaluate_poses(model, hand, poses, curvature=settings["curvature"],
+                                            d_min=grid.d_min).feasible
+        if feasible.any():
+            return poses[np.argmax(feasible)]
+    raise NoFeasibleGrasp(f"none of {RANDOM_BATCH * RANDOM_BATCHES} random poses in the search region is feasible")
+
+
+def _planned(pose, segmentation, metric, camera) -> PlannedGrasp:
+    pose = np.asarray(pose, dtype=float)
+    return PlannedGrasp(pose, pipeline.hand_pose(metric, pose, metric.approach_depth), metric.approach_depth,
+                        segmentation, metric, camera, None)
