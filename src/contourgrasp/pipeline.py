@@ -118,10 +118,36 @@ def plan_grasp(
     NoFeasibleGrasp
         The object was found but no pose satisfies the constraints.
     """
-    if segment not in SEGMENT_CHOICES:
-        raise InputError(f"segment must be one of {SEGMENT_CHOICES}, got {segment!r}")
     if not (math.isfinite(standoff) and standoff >= 0):
         raise InputError(f"standoff must be a distance >= 0, got {standoff}")
+    seg, metric, filled = perceive(rgb, depth, intrinsics, segment=segment, mask=mask, depth_mode=depth_mode,
+                                   fill_holes=fill_holes, approach_offset=approach_offset)
+    plan = synthesize(metric.contour_xy, hand, **synthesis_options)
+    T_camera_hand = hand_pose(metric, plan.pose, metric.approach_depth)
+    T_camera_pregrasp = T_camera_hand.copy()
+    T_camera_pregrasp[:3, 3] -= standoff * T_camera_hand[:3, 2]
+    T_base_hand = None if T_base_camera is None else np.asarray(T_base_camera, dtype=float) @ T_camera_hand
+    return ImageGraspPlan(plan, seg, metric, intrinsics, T_camera_hand, T_camera_pregrasp, T_base_hand, filled)
+
+
+def perceive(
+    rgb,
+    depth,
+    intrinsics: Intrinsics,
+    *,
+    segment: str = "auto",
+    mask=None,
+    depth_mode: str = "max",
+    fill_holes: bool = True,
+    approach_offset: float = perception.APPROACH_OFFSET,
+) -> tuple[Segmentation, MetricContour, int]:
+    """The perception half of :func:`plan_grasp`: (segmentation, metric contour, filled depth pixels).
+
+    Checks the depth, fills small holes, segments (or takes ``mask``) and puts
+    the contour in meters; the options are :func:`plan_grasp`'s.
+    """
+    if segment not in SEGMENT_CHOICES:
+        raise InputError(f"segment must be one of {SEGMENT_CHOICES}, got {segment!r}")
     d = perception.as_depth(depth)
     intrinsics.check_shape(d.shape, "depth image")
     if not perception.valid_depth(d).any():
@@ -137,12 +163,7 @@ def plan_grasp(
     metric = perception.contour_to_metric(
         seg.contour_px, d, intrinsics, depth_mode=depth_mode, plane=seg.plane, offset=approach_offset
     )
-    plan = synthesize(metric.contour_xy, hand, **synthesis_options)
-    T_camera_hand = hand_pose(metric, plan.pose, metric.approach_depth)
-    T_camera_pregrasp = T_camera_hand.copy()
-    T_camera_pregrasp[:3, 3] -= standoff * T_camera_hand[:3, 2]
-    T_base_hand = None if T_base_camera is None else np.asarray(T_base_camera, dtype=float) @ T_camera_hand
-    return ImageGraspPlan(plan, seg, metric, intrinsics, T_camera_hand, T_camera_pregrasp, T_base_hand, filled)
+    return seg, metric, filled
 
 
 def hand_pose(metric: MetricContour, pose, depth: float) -> np.ndarray:

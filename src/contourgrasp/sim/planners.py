@@ -181,24 +181,9 @@ def search_settings(name: str) -> dict:
 
 
 def perceive(rgb, depth, intrinsics: perception.Intrinsics):
-    """The perception of :func:`contourgrasp.pipeline.plan_grasp` with its defaults: (Segmentation, MetricContour).
-
-    The same steps: check the depth, fill small holes, segment (``"auto"``),
-    contour to meters (``"max"`` plane, the default approach offset).
-
-    Raises
-    ------
-    InputError
-        No valid depth, no object found (SegmentationError), no depth on the contour.
-    """
-    d = perception.as_depth(depth)
-    intrinsics.check_shape(d.shape, "depth image")
-    if not perception.valid_depth(d).any():
-        raise InputError("the depth image has no valid reading (all 0, NaN or outside the sensor range)")
-    d, _ = perception.fill_depth_holes(d)
-    segmentation = perception.segment(rgb, d, intrinsics)
-    return segmentation, perception.contour_to_metric(segmentation.contour_px, d, intrinsics,
-                                                      plane=segmentation.plane)
+    """The perception of :func:`contourgrasp.pipeline.plan_grasp` with its defaults: (Segmentation, MetricContour)."""
+    segmentation, metric, _ = pipeline.perceive(rgb, depth, intrinsics)
+    return segmentation, metric
 
 
 def centroid_pose(contour_xy, hand: Hand) -> np.ndarray:
