@@ -8,7 +8,6 @@ from matplotlib.path import Path as MplPath
 
 import contourgrasp as cg
 from contourgrasp import ContourError, NoFeasibleGrasp, efd, synthesis
-from contourgrasp.hand import rotation
 from conftest import disc, rotate
 
 FINE = {"xy_step": 0.02, "yaw_step": math.radians(4)}

@@ -32,8 +32,10 @@ Outer problem (eq 3.32-3.41)
       distances of centimeters point to a square;
     * miss: ``hand.miss_penalty`` per finger that closes on air.
 
-The whole grid is evaluated with numpy, in chunks of poses; there is no Python
-loop per pose.
+Search: :func:`screen_grid` evaluates every grid pose with a compiled kernel
+(contacts on the EFD polygon, curvature from a table); :func:`evaluate_poses`
+then solves the cheapest candidates exactly (numpy, Newton onto the curve).
+There is no Python loop per pose.
 """
 
 from __future__ import annotations
