@@ -639,11 +639,12 @@ def _contacts(model: EFD, hand: Hand, result: PoseEvaluation, i: int, mode: Curv
     return tuple(contacts)
 
 
-def closest_approach(model: EFD, finger, pose, samples: int = 512):
+def closest_approach(model: EFD, finger, pose, samples: int = tol.EFD_SAMPLES, chords: int = 64):
     """Closest approach of a finger's trajectory to the EFD contour at a pose.
 
-    Both curves are sampled (``samples`` points each), so the result is exact to
-    about a sample spacing.
+    The contour is its ``samples``-point polygon and the trajectory a
+    ``chords``-chord polyline; the distance between the two polylines is exact
+    (vertex-to-segment both ways).
 
     Returns
     -------
@@ -656,9 +657,24 @@ def closest_approach(model: EFD, finger, pose, samples: int = 512):
     gap : float
         Their distance, m.
     """
-    lam = np.linspace(0.0, finger.travel, samples)
+    lam = np.linspace(0.0, finger.travel, chords + 1)
     path = to_image(finger.points(lam), pose)
     t, contour = efd_model.sample(model, samples)
-    gaps = np.linalg.norm(path[:, None, :] - contour[None, :, :], axis=2)
-    a, b = np.unravel_index(np.argmin(gaps), gaps.shape)
-    return float(t[b]), float(lam[a]), contour[b], float(gaps[a, b])
+    edges = np.roll(contour, -1, axis=0) - contour
+    steps = np.diff(path, axis=0)
+    # path vertices against contour edges, then contour vertices against path chords
+    s1, gap1 = _point_segment(path, contour, edges)
+    s2, gap2 = _point_segment(contour, path[:-1], steps)
+    if gap1.min() <= gap2.min():
+        i, k = np.unravel_index(np.argmin(gap1), gap1.shape)
+        point = contour[k] + s1[i, k] * edges[k]
+        return float(t[k] + s1[i, k] * model.T / samples), float(lam[i]), point, float(gap1[i, k])
+    k, j = np.unravel_index(np.argmin(gap2), gap2.shape)
+    return float(t[k]), float(lam[j] + s2[k, j] * (lam[j + 1] - lam[j])), contour[k], float(gap2[k, j])
+
+
+def _point_segment(points, starts, vectors):
+    """Fraction along each segment of the nearest point, and the distance: both (n_points, n_segments)."""
+    w = points[:, None, :] - starts[None, :, :]
+    s = np.clip(np.einsum("nsi,si->ns", w, vectors) / np.sum(vectors * vectors, axis=1), 0.0, 1.0)
+    return s, np.linalg.norm(w - s[..., None] * vectors[None], axis=2)
