@@ -509,3 +509,10 @@ def test_real_raw_depth_with_holes():
     metric = contour_to_metric(seg.contour_px, depth, camera, plane=seg.plane, depth_mode="plane")
     (_, _), sides, _ = cv2.minAreaRect(metric.contour_xy.astype(np.float32))
     assert 0.07 < min(sides) < 0.09 and 0.10 < max(sides) < 0.13
+
+
+def test_project_inverts_rays():
+    k = Intrinsics(fx=525.0, fy=520.0, cx=319.5, cy=239.5, width=640, height=480)
+    pixels = np.array([[0.0, 0.0], [319.5, 239.5], [600.2, 33.7]])
+    points = k.rays(pixels) * np.array([[0.5], [0.7], [1.3]])
+    np.testing.assert_allclose(k.project(points), pixels, atol=1e-9)

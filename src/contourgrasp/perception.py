@@ -203,6 +203,11 @@ class Intrinsics:
         uv = np.asarray(pixels, dtype=float).reshape(-1, 2)
         return np.c_[(uv[:, 0] - self.cx) / self.fx, (uv[:, 1] - self.cy) / self.fy, np.ones(len(uv))]
 
+    def project(self, points_camera) -> np.ndarray:
+        """(n, 2) float: pixels (u, v) of camera-frame points (n, 3); the inverse of :meth:`rays`."""
+        p = np.asarray(points_camera, dtype=float).reshape(-1, 3)
+        return np.c_[self.fx * p[:, 0] / p[:, 2] + self.cx, self.fy * p[:, 1] / p[:, 2] + self.cy]
+
 
 @dataclass(frozen=True, eq=False)
 class Plane:

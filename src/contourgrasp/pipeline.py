@@ -175,8 +175,3 @@ def hand_pose(metric: MetricContour, pose, depth: float) -> np.ndarray:
     T[:3, 3] = metric.to_camera([[x, y]], depth=depth)[0]
     return T
 
-
-def project(camera: Intrinsics, points_camera) -> np.ndarray:
-    """(n, 2) float: pixel (u, v) of camera-frame points (n, 3)."""
-    p = np.asarray(points_camera, dtype=float).reshape(-1, 3)
-    return np.c_[camera.fx * p[:, 0] / p[:, 2] + camera.cx, camera.fy * p[:, 1] / p[:, 2] + camera.cy]

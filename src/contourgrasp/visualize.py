@@ -108,9 +108,8 @@ def harmonics_figure(contour_xy, harmonics: Sequence[int] = (1, 2, 4, 8), *, cur
 
 
 def _to_pixels(result, points_xy) -> np.ndarray:
-    cam = result.camera
-    p = result.metric.to_camera(points_xy)
-    return np.c_[cam.fx * p[:, 0] / p[:, 2] + cam.cx, cam.fy * p[:, 1] / p[:, 2] + cam.cy]
+    """(n, 2) float: pixels of planning-frame points (n, 2) in the contour's plane."""
+    return result.camera.project(result.metric.to_camera(points_xy))
 
 
 def image_plan_figure(result, rgb=None) -> Figure:

@@ -9,7 +9,6 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..hand import to_image
-from ..pipeline import project
 from ..visualize import FINGER_COLOURS
 from .bench import SHORT_CAUSES, Bench, label, success_rates, thesis_rates
 
@@ -102,4 +101,4 @@ def draw_side_panel(ax, snap) -> None:
 
 def _pixels(planned, points_xy) -> np.ndarray:
     """(n, 2) float: pixels of planning-frame points (n, 2) in the contour's plane."""
-    return project(planned.camera, planned.metric.to_camera(points_xy))
+    return planned.camera.project(planned.metric.to_camera(points_xy))
