@@ -93,6 +93,7 @@ def _parser() -> argparse.ArgumentParser:
     _add_synthesis_options(plan)
 
     _add_bench_parser(sub)
+    _add_calibrate_parser(sub)
 
     harm = sub.add_parser("efd", help="approximate a contour with several harmonic counts")
     harm.add_argument("--contour", required=True, help=contour_help)
@@ -130,6 +131,13 @@ def _add_bench_parser(sub) -> None:
     bench.add_argument("--out", default="bench-output", help="output folder (created if missing)")
     bench.add_argument("--noise", action=argparse.BooleanOptionalAction, default=True,
                        help="depth sensor noise in the planner's picture")
+
+
+def _add_calibrate_parser(sub) -> None:
+    calibrate = sub.add_parser("calibrate", help="lambda_virt (virtual starts) from the simulated hand's closing")
+    calibrate.add_argument("--hand", default="five-finger-linear", help="preset name or hand TOML file (ray fingers)")
+    calibrate.add_argument("--reference", help="finger given lambda_virt 0 (default: the one that closes last)")
+    calibrate.add_argument("--out", help="write the hand TOML with the calibrated virtual starts here")
 
 
 def _synthesis_options(args) -> dict:
@@ -230,6 +238,22 @@ def _bench(args) -> int:
     return EXIT_OK
 
 
+def _calibrate(args) -> int:
+    from .io.hand_file import hand_to_toml
+    from .sim.calibrate import calibrate_virtual_starts, calibration_table
+
+    calibration = calibrate_virtual_starts(load_hand(args.hand), reference=args.reference)
+    print("\n".join(calibration_table(calibration)))
+    if args.out is not None:
+        comment = (f"{calibration.hand.name} with virtual starts (lambda_virt) calibrated by `contourgrasp calibrate`\n"
+                   f"from the simulated hand closing in free space (trial actuation, reference finger "
+                   f"{calibration.reference}).")
+        with atomic_outputs(args.out) as (out,):
+            out.write_text(hand_to_toml(calibration.calibrated_hand(), comment=comment), encoding="utf-8")
+        print(f"calibrated hand -> {args.out}")
+    return EXIT_OK
+
+
 def _efd(args) -> int:
     contour = efd.clean_polygon(_contour(args.contour))
     for k in args.harmonics:
@@ -246,7 +270,8 @@ def _efd(args) -> int:
     return EXIT_OK
 
 
-COMMANDS = {"hands": _hands, "synth": _synth, "plan": _plan, "bench": _bench, "efd": _efd}
+COMMANDS = {"hands": _hands, "synth": _synth, "plan": _plan, "bench": _bench, "efd": _efd,
+            "calibrate": _calibrate}
 
 
 def main(argv=None) -> int:

@@ -1,10 +1,12 @@
 import math
 
+import numpy as np
 import pytest
 
 import contourgrasp as cg
 from contourgrasp import HandFileError
-from contourgrasp.io.hand_file import load_hand, parse_hand
+from contourgrasp.hand import Finger, Hand, Ray
+from contourgrasp.io.hand_file import hand_to_toml, load_hand, parse_hand, preset_names
 
 GOOD = """
 name = "pinch"
@@ -79,3 +81,21 @@ def test_presets_have_the_table_values():
     assert [f.virtual_start for f in hand.fingers] == [0.03, 0.0, 0.0, 0.01, 0.01]
     three = load_hand("three-finger")
     assert [f.beta for f in three.fingers] == [5e4] * 3 and three.min_touching == 3
+
+
+@pytest.mark.parametrize("name", preset_names())
+def test_hand_to_toml_round_trips(name):
+    hand = load_hand(name)
+    again = parse_hand(hand_to_toml(hand, comment="a\nb"))
+    assert (again.name, again.min_touching, again.miss_penalty) == (hand.name, hand.min_touching, hand.miss_penalty)
+    for f, g in zip(hand.fingers, again.fingers, strict=True):
+        assert (g.name, g.start, g.travel, g.virtual_start, g.alpha, g.beta, g.required) == (
+            f.name, f.start, f.travel, f.virtual_start, f.alpha, f.beta, f.required)
+        np.testing.assert_allclose(g.points([0.0, 0.01]), f.points([0.0, 0.01]), atol=1e-15)
+
+
+def test_hand_to_toml_escapes_names():
+    finger = Finger(name='the "odd" one\\ ä\x7f', start=(0.0, 0.0), trajectory=Ray((0.0, 1.0)), travel=0.05)
+    hand = Hand(name="x\ny", fingers=(finger,), min_touching=1, description="tab\there")
+    again = parse_hand(hand_to_toml(hand))
+    assert (again.name, again.fingers[0].name, again.description) == (hand.name, finger.name, hand.description)

@@ -26,6 +26,7 @@ Unknown keys, wrong types and impossible values are refused with
 
 from __future__ import annotations
 
+import json
 import tomllib
 from importlib import resources
 from pathlib import Path
@@ -191,3 +192,34 @@ def _finger_name(raw: dict, index: int) -> str | None:
     except (KeyError, IndexError, TypeError):
         return None
     return name if isinstance(name, str) else None
+
+
+def hand_to_toml(hand: Hand, *, comment: str = "") -> str:
+    """The text of a hand file that loads back as ``hand``, ``comment`` as its header."""
+    lines = [f"# {line}".rstrip() for line in comment.splitlines()]
+    lines += [f"name = {_string(hand.name)}", f"description = {_string(hand.description)}",
+              f"min_touching = {hand.min_touching}", f"miss_penalty = {_float(hand.miss_penalty)}"]
+    for f in hand.fingers:
+        lines += ["", "[[fingers]]", f"name = {_string(f.name)}", f"start = {_floats(f.start)}"]
+        if isinstance(f.trajectory, Ray):
+            lines.append(f"closing_direction = {_floats(f.trajectory.closing_direction)}")
+        else:
+            arc = f.trajectory
+            lines.append(f"arc = {{ a_cos = {_float(arc.a_cos)}, a_sin = {_float(arc.a_sin)}, "
+                         f"phi_off = {_float(arc.phi_off)} }}")
+        lines += [f"travel = {_float(f.travel)}", f"virtual_start = {_float(f.virtual_start)}",
+                  f"alpha = {_float(f.alpha)}", f"beta = {_float(f.beta)}", f"required = {str(f.required).lower()}"]
+    return "\n".join(lines) + "\n"
+
+
+def _string(text: str) -> str:
+    # JSON's escapes are TOML's; TOML also refuses a raw DEL, which JSON leaves alone.
+    return json.dumps(text, ensure_ascii=False).replace("\x7f", "\\u007f")
+
+
+def _float(value) -> str:
+    return repr(float(value))  # shortest text that reads back as the same float; TOML parses it
+
+
+def _floats(values) -> str:
+    return "[" + ", ".join(map(_float, values)) + "]"
