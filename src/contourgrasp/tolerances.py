@@ -40,3 +40,22 @@ REFINE_CANDIDATES = 32
 
 #: Poses evaluated at once; bounds the memory of the (poses, segments, edges) arrays.
 POSE_CHUNK = 256
+
+#: Wrench-space zero (wrenches scaled to unit normal force, torque / rho): a Ferrari-Canny
+#: epsilon at or below this is no force closure, and a wrench this far outside a plane
+#: still counts as on it.
+WRENCH_ZERO = 1e-9
+
+#: A contact normal shorter than this has no direction.
+MIN_NORMAL = 1e-12
+
+#: Adaptive harmonics (efd.choose_harmonics): the fewest and most harmonics it may choose.
+#: With 1-2 harmonics the thesis's objects have no concave stretch (thesis 4.2.1, Figure 4.5 a-b).
+HARMONICS_BOUNDS = (3, 12)
+
+#: Default of the "rms" rule: RMS distance to the upper-bound model, as a fraction of sqrt(area).
+#: Chosen by `python tools/harmonics_figure.py --sweep` (table in efd.choose_harmonics).
+HARMONICS_RMS_TOLERANCE = 0.008
+
+#: Default of the "power" rule: share of the first harmonics' power the model may leave out.
+HARMONICS_POWER_TOLERANCE = 2e-4

@@ -1,0 +1,428 @@
+"""Grasp quality: 2-D force closure and the Ferrari-Canny epsilon metric.
+
+The thesis traces the failures on the glasses case to "all grasping points
+laying on the same surface" (chapter 5, failure 2) and proposes a force-closure
+test (section 6.1, item 2). This module provides it, together with the epsilon
+metric of Ferrari & Canny (1992, "Planning optimal grasps", ICRA), which also
+says how far a grasp is from losing closure. Everything here is a pure function
+of numpy arrays; the planner decides how to use the numbers.
+
+Conventions
+-----------
+Contacts
+    Point contacts with Coulomb friction mu, in the plane. Contact i sits at
+    p_i with unit normal n_i pointing *into* the object (normals of any
+    positive length are normalised; zero ones are refused) and tangent t_i, n_i
+    rotated by +90 deg. In 2-D a friction cone has exactly two edges, so it is
+    represented exactly, not approximated::
+
+        f_i+ = n_i + mu t_i,    f_i- = n_i - mu t_i
+
+    Edges are scaled to a *unit normal component*, not to unit length: an edge
+    is the largest friction force that goes with a unit normal force. Then the
+    cone edges for a smaller mu are convex combinations of those for a larger
+    one, so epsilon never decreases as mu grows (unit-length edges would
+    shrink instead).
+Wrenches
+    w = (f_x, f_y, tau / rho) with tau = (p - c) x f, the z component of the
+    torque about a reference point c, and rho a characteristic length that
+    makes the torque commensurate with the force. Defaults: c = ``centre`` =
+    the centroid of the contacts, rho = the largest distance of a contact from
+    c (1 when all contacts are at c). Force closure does not depend on c or rho
+    (changing them maps wrench space linearly and invertibly), epsilon does: to
+    compare grasps on one object pass the same ``centre`` and ``rho`` to every
+    call, e.g. the object's centroid and its largest radius about it.
+Metrics
+    ``"L1"``: the grasp wrench space is the convex hull of the 2n edge wrenches,
+    the wrenches the grasp can exert with a *sum* of normal forces <= 1
+    (Ferrari & Canny's Q_1). ``"Linf"``: the Minkowski sum over contacts of
+    conv{0, w_i+, w_i-}, the wrenches with *each* normal force <= 1. Ferrari &
+    Canny sum the edges alone; we include the zero force so that a contact may
+    push less than another: without it two antipodal contacts would always
+    cancel their normal forces and span a flat set. Both metrics agree on force
+    closure and eps_L1 <= eps_Linf <= n eps_L1.
+
+    epsilon is the radius of the largest origin-centred ball inside the grasp
+    wrench space: the smallest distance of the origin to a facet's plane when
+    the origin is strictly inside, else 0. The grasp is in force closure iff
+    epsilon > 0. Values at or below :data:`tolerances.WRENCH_ZERO` are
+    reported as 0, and so are degenerate wrench sets (fewer than four affinely
+    independent wrenches: one contact, or frictionless contacts whose normal
+    lines meet in one point, e.g. any frictionless grasp of a disc) -- never an
+    exception.
+
+With two contacts this reduces to Nguyen's test (1988): closure iff the
+segment joining the contacts lies strictly inside both friction cones, i.e.
+makes an angle below atan(mu) with both normals.
+"""
+
+from __future__ import annotations
+
+import functools
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import ConvexHull, QhullError
+
+from . import efd
+from . import tolerances as tol
+from .errors import InputError
+
+METRICS: tuple[str, ...] = ("L1", "Linf")
+
+#: The L-inf wrench space has 3**n vertices before the hull; beyond this it is refused.
+LINF_MAX_CONTACTS = 8
+
+#: Elements of the (poses, planes, wrenches) array evaluated at once by :func:`epsilon_many`.
+_BATCH_ELEMENTS = 2_000_000
+
+
+@dataclass(frozen=True)
+class GraspQuality:
+    """Quality of one grasp (Ferrari & Canny 1992; thesis 6.1 item 2).
+
+    Attributes
+    ----------
+    force_closure : bool
+        The grasp can resist any wrench (origin strictly inside the grasp wrench space).
+    epsilon : float
+        Ferrari-Canny epsilon in units of unit normal force; 0 without closure.
+    metric : {"L1", "Linf"}
+    mu : float
+        Friction coefficient used.
+    """
+
+    force_closure: bool
+    epsilon: float
+    metric: str
+    mu: float
+
+
+# --------------------------------------------------------------------- public
+
+
+def contact_wrenches(points, normals, *, mu: float = 0.5, centre=None, rho=None) -> np.ndarray:
+    """Wrenches of the friction-cone edges of planar point contacts.
+
+    Parameters
+    ----------
+    points : (n, 2) float
+        Contact points, meters.
+    normals : (n, 2) float
+        Normals pointing into the object; normalised here.
+    mu : float
+        Coulomb friction coefficient, >= 0.
+    centre : (2,) float, optional
+        Point the torques are taken about; default the contacts' centroid.
+    rho : float, optional
+        Characteristic length dividing the torque; default the largest
+        distance of a contact from ``centre``.
+
+    Returns
+    -------
+    (2n, 3) float
+        Rows (f_x, f_y, tau / rho) in the order f_0+, f_0-, f_1+, ..., each
+        edge n_i +/- mu t_i scaled to a unit normal component (module docstring).
+
+    Raises
+    ------
+    InputError
+        Naming the argument that is malformed.
+    """
+    p, n = _check_contacts(points, normals)
+    mu = _check_mu(mu)
+    c, r = _frame(p[None], np.ones((1, len(p)), bool), centre, rho)
+    return _edge_wrenches(p[None], n[None], mu, c, r)[0]
+
+
+def epsilon(points, normals, *, mu: float = 0.5, centre=None, rho=None, metric: str = "L1") -> float:
+    """Ferrari-Canny epsilon of one grasp: the largest origin-centred ball in its wrench space.
+
+    Parameters are those of :func:`contact_wrenches`, plus
+
+    metric : {"L1", "Linf"}
+        ``"L1"`` bounds the sum of the normal forces, ``"Linf"`` each of them
+        (module docstring; Ferrari & Canny 1992). ``"Linf"`` takes at most
+        :data:`LINF_MAX_CONTACTS` contacts.
+
+    Returns
+    -------
+    float
+        >= 0; 0 exactly when the grasp is not in force closure (thesis 6.1
+        item 2, chapter 5 failure 2: contacts all on one surface give 0).
+
+    Examples
+    --------
+    Two antipodal contacts on a box, torques about their midpoint:
+
+    >>> round(epsilon([[-0.03, 0], [0.03, 0]], [[1, 0], [-1, 0]], mu=0.5), 6)
+    0.333333
+    """
+    metric = _check_metric(metric)
+    w = contact_wrenches(points, normals, mu=mu, centre=centre, rho=rho)
+    if metric == "Linf":
+        _check_linf_size(len(w) // 2)
+        w = _minkowski_sum(w.reshape(-1, 2, 3))
+    return _ball_radius(w)
+
+
+def force_closure(points, normals, *, mu: float = 0.5, centre=None, rho=None) -> bool:
+    """Whether the grasp is in 2-D force closure: its L1 epsilon is positive.
+
+    Parameters are those of :func:`contact_wrenches`; ``centre`` and ``rho``
+    do not change the answer except within :data:`tolerances.WRENCH_ZERO` of
+    the boundary.
+    """
+    return epsilon(points, normals, mu=mu, centre=centre, rho=rho) > 0.0
+
+
+def grasp_quality(
+    points, normals, *, mu: float = 0.5, centre=None, rho=None, metric: str = "L1"
+) -> GraspQuality:
+    """Force closure and epsilon of one grasp, as a :class:`GraspQuality`.
+
+    Parameters are those of :func:`epsilon`.
+    """
+    eps = epsilon(points, normals, mu=mu, centre=centre, rho=rho, metric=metric)
+    return GraspQuality(force_closure=eps > 0.0, epsilon=eps, metric=metric, mu=float(mu))
+
+
+def epsilon_many(
+    points, normals, valid=None, *, mu: float = 0.5, centre=None, rho=None, metric: str = "L1"
+) -> np.ndarray:
+    """Epsilon of many grasps at once, e.g. the candidate poses of one plan.
+
+    Parameters
+    ----------
+    points : (p, n, 2) float
+        Contact points of p grasps with up to n contacts each.
+    normals : (p, n, 2) float
+        Inward normals at those points.
+    valid : (p, n) bool, optional
+        Which contacts exist (a finger that misses the object has none);
+        invalid entries may hold anything, NaN included. Default all.
+    mu : float
+    centre : (2,) or (p, 2) float, optional
+        Torque reference per grasp; default each grasp's contact centroid.
+    rho : float or (p,) float, optional
+        Characteristic length per grasp; default each grasp's own (see
+        :func:`contact_wrenches`). Pass one value to make the grasps comparable.
+    metric : {"L1", "Linf"}
+
+    Returns
+    -------
+    (p,) float
+        ``epsilon_many(...)[k]`` equals :func:`epsilon` of grasp k's valid
+        contacts to within rounding. The L1 metric is vectorised over grasps
+        (every plane through three wrenches is tested as a supporting plane);
+        ``"Linf"`` loops over grasps with Qhull.
+    """
+    metric = _check_metric(metric)
+    mu = _check_mu(mu)
+    p, n, ok = _check_contact_batch(points, normals, valid)
+    c, r = _frame(p, ok, centre, rho)
+    w = _edge_wrenches(p, n, mu, c, r)
+    if metric == "L1":
+        return _ball_radius_batch(w, np.repeat(ok, 2, axis=1))
+    _check_linf_size(int(ok.sum(axis=1).max(initial=0)))
+    pairs = w.reshape(len(w), -1, 2, 3)
+    return np.array([_ball_radius(_minkowski_sum(pairs[k][ok[k]])) for k in range(len(w))])
+
+
+def contour_normals(model: efd.EFD, t) -> np.ndarray:
+    """Inward unit normals of an EFD contour at parameters t.
+
+    Parameters
+    ----------
+    model : EFD
+        A model from :func:`contourgrasp.efd.fit`.
+    t : (...) float
+        Curve parameters (arc length, meters).
+
+    Returns
+    -------
+    (..., 2) float
+        Unit normals pointing into the object; NaN where the curve's tangent
+        vanishes (a cusp of a truncated series), which the quality functions refuse.
+    """
+    t = np.asarray(t, dtype=float)
+    tangent = efd.evaluate(model, t.ravel(), derivative=1)
+    # fit() orients every model with positive signed area (counter-clockwise
+    # with y up), so the interior lies to the left: rotate the tangent by +90 deg.
+    inward = np.stack([-tangent[:, 1], tangent[:, 0]], axis=-1)
+    length = np.linalg.norm(inward, axis=-1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        unit = np.where(length > tol.MIN_NORMAL, inward / length, np.nan)
+    return unit.reshape(t.shape + (2,))
+
+
+# ------------------------------------------------------------------ internals
+
+
+def _edge_wrenches(p, n, mu, centre, rho) -> np.ndarray:
+    """(g, 2k, 3) edge wrenches of g grasps from points, unit normals (g, k, 2), centre (g, 2), rho (g,)."""
+    t = np.stack([-n[..., 1], n[..., 0]], axis=-1)
+    f = n[..., None, :] + mu * np.array([1.0, -1.0])[:, None] * t[..., None, :]  # (g, k, 2, 2)
+    arm = (p - centre[:, None, :])[..., None, :]
+    tau = arm[..., 0] * f[..., 1] - arm[..., 1] * f[..., 0]
+    w = np.concatenate([f, (tau / rho[:, None, None])[..., None]], axis=-1)
+    return w.reshape(len(p), -1, 3)
+
+
+def _frame(p, ok, centre, rho) -> tuple[np.ndarray, np.ndarray]:
+    """Per-grasp torque reference (g, 2) and characteristic length (g,), defaults filled in."""
+    g = len(p)
+    if centre is None:
+        count = np.maximum(ok.sum(axis=1, keepdims=True), 1)
+        c = np.where(ok[..., None], p, 0.0).sum(axis=1) / count
+    else:
+        c = np.asarray(centre, dtype=float)
+        if c.shape not in {(2,), (g, 2)} or not np.all(np.isfinite(c)):
+            raise InputError(f"centre must be a finite (2,) point (or (p, 2) for many grasps), got {c.shape}")
+        c = np.broadcast_to(c, (g, 2))
+    if rho is None:
+        reach = np.where(ok, np.linalg.norm(p - c[:, None, :], axis=-1), 0.0).max(axis=1, initial=0.0)
+        # Contacts all at the centre exert no torque whatever rho is; 1 avoids 0 / 0.
+        return c, np.where(reach > 0.0, reach, 1.0)
+    r = np.asarray(rho, dtype=float)
+    if r.shape not in {(), (g,)} or not np.all(np.isfinite(r) & (r > 0)):
+        raise InputError(f"rho must be a positive finite length (or (p,) of them), got {rho!r}")
+    return c, np.broadcast_to(r, (g,))
+
+
+def _ball_radius(w: np.ndarray) -> float:
+    """Radius of the largest origin-centred ball in conv(w), by Qhull; 0 if none or flat."""
+    if len(w) < 4:
+        return 0.0
+    try:
+        hull = ConvexHull(w)
+    except QhullError:  # flat or otherwise degenerate: no interior, no closure
+        return 0.0
+    # equations are (unit outward normal, offset) with normal . x + offset <= 0 inside,
+    # so -offset is the origin's distance to each facet, negative where it is outside.
+    radius = float(np.min(-hull.equations[:, -1]))
+    return radius if radius > tol.WRENCH_ZERO else 0.0
+
+
+def _ball_radius_batch(w: np.ndarray, ok: np.ndarray) -> np.ndarray:
+    """(g,) ball radii of conv(w[k][ok[k]]) for w (g, m, 3), without Qhull.
+
+    A plane through three of the points with all points on one side is a
+    facet's plane, and every facet has one, so the radius is the least
+    distance of the origin to such a plane (negative when it is outside).
+    A near-degenerate triple gives a poorly defined plane, but one that still
+    passes the one-side test is a supporting plane, whose distance is never
+    below the true radius: such planes cannot make the answer wrong.
+    """
+    g, m, _ = w.shape
+    out = np.zeros(g)
+    if m < 4:
+        return out
+    i, j, k = _triples(m)
+    chunk = max(1, _BATCH_ELEMENTS // (len(i) * m))
+    for s in range(0, g, chunk):
+        ws, oks = w[s : s + chunk], ok[s : s + chunk]
+        a = ws[:, i]
+        normal = np.cross(ws[:, j] - a, ws[:, k] - a)
+        length = np.linalg.norm(normal, axis=-1)
+        usable = oks[:, i] & oks[:, j] & oks[:, k] & (length > 0.0)
+        unit = normal / np.where(usable, length, 1.0)[..., None]
+        h = np.einsum("gtd,gtd->gt", unit, a)  # the plane is unit . x = h
+        side = np.einsum("gtd,gmd->gtm", unit, ws) - h[..., None]
+        side = np.where(oks[:, None, :], side, 0.0)
+        below = usable & np.all(side <= tol.WRENCH_ZERO, axis=-1)  # outward normal +unit
+        above = usable & np.all(side >= -tol.WRENCH_ZERO, axis=-1)  # outward normal -unit
+        dist = np.minimum(np.where(below, h, np.inf), np.where(above, -h, np.inf)).min(axis=1)
+        out[s : s + chunk] = np.where(np.isfinite(dist) & (dist > tol.WRENCH_ZERO), dist, 0.0)
+    return out
+
+
+@functools.lru_cache(maxsize=32)
+def _triples(m: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    return tuple(np.array(list(itertools.combinations(range(m), 3))).T)
+
+
+def _minkowski_sum(pairs: np.ndarray) -> np.ndarray:
+    """(3**k, 3) sums of one of {0, w+, w-} per contact, from pairs (k, 2, 3)."""
+    sums = np.zeros((1, 3))
+    for edges in pairs:
+        choices = np.vstack([np.zeros((1, 3)), edges])
+        sums = (sums[:, None, :] + choices[None]).reshape(-1, 3)
+    return sums
+
+
+# ------------------------------------------------------------------ validation
+
+
+def _check_contacts(points, normals) -> tuple[np.ndarray, np.ndarray]:
+    """Points and unit normals (n, 2) of one grasp."""
+    p, n = _as_float(points, "points"), _as_float(normals, "normals")
+    if p.ndim != 2 or p.shape[1] != 2:
+        raise InputError(f"points must be an (n, 2) array, got shape {p.shape}")
+    if n.shape != p.shape:
+        raise InputError(f"normals must have the shape of points {p.shape}, got {n.shape}")
+    p, n = _check_values(p, n)
+    return p, n
+
+
+def _check_contact_batch(points, normals, valid) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Points, unit normals (g, k, 2) with invalid entries neutralised, and the valid mask (g, k)."""
+    p, n = _as_float(points, "points"), _as_float(normals, "normals")
+    if p.ndim != 3 or p.shape[2] != 2:
+        raise InputError(f"points must be a (p, n, 2) array, got shape {p.shape}")
+    if n.shape != p.shape:
+        raise InputError(f"normals must have the shape of points {p.shape}, got {n.shape}")
+    ok = np.ones(p.shape[:2], bool) if valid is None else np.asarray(valid)
+    if ok.shape != p.shape[:2] or ok.dtype != bool:
+        raise InputError(f"valid must be a {p.shape[:2]} bool array, got {ok.dtype} {ok.shape}")
+    # Invalid contacts may hold NaN; give them harmless values, the mask drops them later.
+    p, n = _check_values(np.where(ok[..., None], p, 0.0), np.where(ok[..., None], n, 1.0))
+    return p, n, ok
+
+
+def _check_values(p: np.ndarray, n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Refuse non-finite entries and zero normals; return the normals normalised."""
+    for name, a in (("points", p), ("normals", n)):
+        bad = ~np.all(np.isfinite(a), axis=-1)
+        if np.any(bad):
+            raise InputError(f"{name}{_index(bad)} is not finite")
+    length = np.linalg.norm(n, axis=-1)
+    if np.any(length <= tol.MIN_NORMAL):
+        raise InputError(f"normals{_index(length <= tol.MIN_NORMAL)} has zero length: no direction")
+    return p, n / length[..., None]
+
+
+def _check_mu(mu) -> float:
+    try:
+        value = float(mu)
+    except (TypeError, ValueError):
+        raise InputError(f"mu must be a number, got {mu!r}") from None
+    if not np.isfinite(value) or value < 0:
+        raise InputError(f"mu must be a finite friction coefficient >= 0, got {mu!r}")
+    return value
+
+
+def _check_metric(metric) -> str:
+    if metric not in METRICS:
+        raise InputError(f"metric must be one of {METRICS}, got {metric!r}")
+    return metric
+
+
+def _check_linf_size(k: int) -> None:
+    if k > LINF_MAX_CONTACTS:
+        raise InputError(
+            f"metric 'Linf' takes at most {LINF_MAX_CONTACTS} contacts (3**n wrenches), got {k} points"
+        )
+
+
+def _as_float(a, name: str) -> np.ndarray:
+    try:
+        return np.asarray(a, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be an array of numbers") from None
+
+
+def _index(mask: np.ndarray) -> str:
+    """'[i]' or '[k, i]': the first True entry of mask."""
+    return str(list(int(v) for v in np.argwhere(mask)[0]))
