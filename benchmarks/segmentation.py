@@ -4,7 +4,8 @@ Every frame of ``<data>/rgbd/*/`` that has ``color_N.png``, ``depth_N.npy`` and
 ``segmask_N.png`` (and an ``.intr`` file in its folder) is segmented with each
 method of :func:`contourgrasp.perception.segment`; the script prints a
 Markdown table of the IoU per frame, the mean, the worst frame and the time
-per frame. A refused frame (SegmentationError) scores IoU 0.
+per frame. A refused frame (SegmentationError) scores IoU 0; a note in brackets
+says which method ``auto`` used (``depth``, ``depth+rgb`` or ``rgb``).
 
 Usage::
 

@@ -29,6 +29,7 @@ from contourgrasp.perception import (
     PerceptionWarning,
     Plane,
     SegmentationError,
+    add_flat_parts,
     approach_depth,
     contour_to_metric,
     fill_depth_holes,
@@ -136,6 +137,31 @@ def test_plane_fit_is_deterministic_and_ignores_outliers():
     assert first.inliers[:2000].all() and first.inliers[2000:].mean() < 0.05
 
 
+def test_plane_scored_on_a_sample_is_refitted_on_all_points():
+    # 30,000 points, 40 % clutter above a tilted table; candidates are scored on 300 of them only.
+    rng = np.random.default_rng(2)
+    normal = np.array([0.0, -math.sin(0.3), -math.cos(0.3)])
+    along = np.array([[1.0, 0.0, 0.0], np.cross(normal, [1.0, 0.0, 0.0])])
+    table = -0.7 * normal + rng.uniform(-0.3, 0.3, (18000, 2)) @ along + rng.uniform(-1e-3, 1e-3, (18000, 1)) * normal
+    clutter = -0.7 * normal + rng.uniform(-0.3, 0.3, (12000, 2)) @ along + rng.uniform(0.02, 0.3, (12000, 1)) * normal
+    points = np.vstack([table, clutter])
+    sampled, scored_on_all = fit_plane(points, sample=300), fit_plane(points, sample=len(points))
+    assert sampled.normal @ normal == pytest.approx(1.0, abs=1e-6)
+    assert sampled.offset == pytest.approx(0.7, abs=1e-4)
+    np.testing.assert_array_equal(sampled.inliers, np.arange(len(points)) < len(table))
+    np.testing.assert_allclose(sampled.normal, scored_on_all.normal, atol=1e-12)
+
+
+def test_plane_holding_the_most_points_wins_over_a_near_tie():
+    # A table and a platter 2 cm above it with 2 % fewer points: a 300-point sample cannot tell them apart.
+    rng = np.random.default_rng(4)
+    table = np.c_[rng.uniform(-0.3, 0.3, (10200, 2)), np.full(10200, 0.8)]
+    platter = np.c_[rng.uniform(-0.3, 0.3, (9800, 2)), np.full(9800, 0.78)]
+    points = np.vstack([table, platter])
+    for seed in range(8):
+        assert fit_plane(points, sample=300, seed=seed).offset == pytest.approx(0.8)
+
+
 def test_no_table_plane_in_noise():
     rng = np.random.default_rng(0)
     depth = rng.uniform(0.3, 1.4, (H, W))
@@ -178,6 +204,63 @@ def test_auto_falls_back_to_rgb_without_a_table():
         seg = segment(rgb, np.zeros((H, W)), CAMERA)
     assert seg.method == "rgb" and "used the RGB method" in seg.warnings[0]
     assert iou(seg.mask, truth) > 0.95
+
+
+def with_flat_part(rgb, truth, colour=(230, 230, 230)):
+    """The scene with a flat plate (table height, another colour) joined to the object's right side."""
+    rows, cols = np.nonzero(truth)
+    plate = np.zeros_like(truth)
+    plate[rows.min() + 5: rows.max() - 5, cols.max() - 2: cols.max() + 60] = True
+    painted = rgb.copy()
+    painted[plate & ~truth] = colour
+    return painted, truth | plate
+
+
+def test_auto_adds_a_flat_part_that_depth_cannot_see():
+    depth, rgb, truth, _ = render(tilt_deg=12.7, height=0.02)
+    rgb, whole = with_flat_part(rgb, truth)
+    assert iou(segment_depth(depth, CAMERA).mask, whole) < 0.7
+    seg = segment(rgb, depth, CAMERA)
+    assert seg.method == "depth+rgb" and seg.plane is not None and seg.warnings == ()
+    assert iou(seg.mask, whole) > 0.95
+    np.testing.assert_array_equal(segment(rgb, depth, CAMERA).mask, seg.mask)  # GrabCut is seeded
+
+
+def test_auto_ignores_a_shadow_band_along_the_depth_outline():
+    depth, rgb, truth, _ = render()
+    band = ndimage.binary_dilation(truth, iterations=4) & ~truth
+    rgb[band] = (40, 80, 20)
+    seg = segment(rgb, depth, CAMERA)
+    assert seg.method == "depth"
+    np.testing.assert_array_equal(seg.mask, segment_depth(depth, CAMERA).mask)
+
+
+def test_auto_finds_a_flat_object_of_another_colour():
+    depth, rgb, _, _ = render(kind="none")
+    flat = np.zeros((H, W), dtype=bool)
+    flat[200:260, 280:380] = True
+    rgb[flat] = OBJECT_RGB
+    with pytest.warns(PerceptionWarning, match="nothing|no region"):
+        seg = segment(rgb, depth, CAMERA)
+    assert seg.method == "rgb" and iou(seg.mask, flat) > 0.9
+
+
+def test_auto_on_a_blank_table_says_no_object():
+    depth, rgb, _, _ = render(kind="none")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PerceptionWarning)
+        with pytest.raises(SegmentationError, match="no object found") as err:
+            segment(rgb, depth, CAMERA)
+    assert err.value.kind == "no-object"
+
+
+def test_flat_part_reaching_the_border_is_refused():
+    depth, rgb, truth, _ = render(centre=(0.2, 0.0), height=0.02)
+    rows, cols = np.nonzero(truth)
+    rgb[rows.min() + 5: rows.max() - 5, cols.max():] = (230, 230, 230)
+    with pytest.raises(SegmentationError, match="not completely visible") as err:
+        segment(rgb, depth, CAMERA)
+    assert err.value.kind == "not-visible"
 
 
 def test_auto_uses_rgb_without_depth():
@@ -232,6 +315,22 @@ def test_depth_holes_are_filled_when_small():
     assert segment_depth(holed, CAMERA).filled_px == 38
     assert segment_depth(holed, CAMERA, fill_holes=False).filled_px == 0
     assert iou(segment_depth(holed, CAMERA).mask, truth) > 0.95
+
+
+@settings(max_examples=100, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), missing=st.floats(0.05, 0.9), max_hole_px=st.sampled_from([1, 6, 40, 10**6]))
+def test_hole_takes_the_nearest_reading_of_the_whole_image(seed, missing, max_hole_px):
+    # The fill looks for readings near the holes only; it must find those of a search over the whole image.
+    rng = np.random.default_rng(seed)
+    depth = rng.uniform(0.5, 1.0, tuple(rng.integers(2, 40, 2)))
+    depth[rng.random(depth.shape) < missing] = 0.0
+    filled, count = fill_depth_holes(depth, max_hole_px=max_hole_px)
+    labels, _ = ndimage.label(depth == 0, structure=np.ones((3, 3)))
+    small = (np.bincount(labels.ravel()) <= max_hole_px)[labels] & (labels > 0)
+    _, (rows, cols) = ndimage.distance_transform_edt(depth == 0, return_indices=True)
+    expected = np.where(small & (depth != 0).any(), depth[rows, cols], depth)
+    np.testing.assert_array_equal(filled, expected)
+    assert count == (small.sum() if (depth != 0).any() else 0)
 
 
 def test_user_mask_becomes_a_segmentation():
@@ -391,6 +490,11 @@ def test_bad_input_messages():
         (lambda: Intrinsics(fx=0, fy=1, cx=0, cy=0, width=4, height=4), "fx must be positive"),
         (lambda: Intrinsics(fx=1, fy=1, cx=0, cy=0, width=4.5, height=4), "width must be a positive whole"),
         (lambda: fill_depth_holes(np.zeros((2, 2, 2))), r"\(H, W\) array"),
+        (lambda: fit_plane(np.zeros((5, 3)), sample=2), "sample must be an integer >= 3"),
+        (lambda: segment(rgb, depth, CAMERA, colour_options={"halo": 3}), "colour_options: unknown option 'halo'"),
+        (lambda: add_flat_parts(rgb, segment_rgb(rgb)), "needs a depth segmentation"),
+        (lambda: add_flat_parts(rgb, segment_depth(depth, CAMERA), colour_distance=0), "colour_distance must be positive"),
+        (lambda: add_flat_parts(rgb[:10], segment_depth(depth, CAMERA)), "rgb image is 640x10 but mask is 640x480"),
     ]
     for call, message in cases:
         with pytest.raises(InputError, match=message):
@@ -446,10 +550,12 @@ needs_data = pytest.mark.skipif(
 )
 #: Footprint (short, long side, m) of each object, from shared/data/README.md.
 FOOTPRINTS = {0: (0.063, 0.19), 2: (0.066, 0.14), 4: (0.068, 0.085), 8: (0.074, 0.106)}
+#: Issue 3's floor: no frame below this IoU with the default method.
+TARGET_WORST_IOU = 0.75
 CAN_OPENER = pytest.mark.xfail(
     strict=True,
-    reason="frame 6, a can opener lying flat: its metal head is under 3 mm high, invisible to depth, "
-    "and only its raised grip is found",
+    reason="frame 6, a can opener lying flat: its metal head (under 3 mm high) is found by colour, but the "
+    "hand-made mask leaves out part of that head and GrabCut keeps the shaded mat between the handles: IoU 0.68",
 )
 
 
@@ -466,10 +572,20 @@ def load_frame(index):
 
 @needs_data
 @pytest.mark.parametrize("index", [0, 2, 4, pytest.param(6, marks=CAN_OPENER), 8])
-def test_real_frame_segmentation_matches_the_hand_made_mask(index):
+def test_real_frame_segmentation_reaches_the_issue_floor(index):
     rgb, depth, camera, truth = load_frame(index)
-    seg = segment(rgb, depth, camera, method="auto")
-    assert iou(seg.mask, truth) >= 0.83
+    assert iou(segment(rgb, depth, camera).mask, truth) >= TARGET_WORST_IOU
+
+
+@needs_data
+@pytest.mark.parametrize(("index", "method", "floor"), [
+    (0, "depth", 0.87), (2, "depth", 0.91), (4, "depth", 0.83), (6, "depth+rgb", 0.65), (8, "depth", 0.86),
+])
+def test_real_frame_segmentation_matches_the_hand_made_mask(index, method, floor):
+    rgb, depth, camera, truth = load_frame(index)
+    seg = segment(rgb, depth, camera)
+    assert seg.method == method
+    assert iou(seg.mask, truth) >= floor
 
 
 @needs_data
