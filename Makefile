@@ -21,10 +21,11 @@ test: $(STAMP)
 demo: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python tools/demo.py demo-output
 
-# The thesis's grasping experiment (Table 4.4) in simulation: 5 objects x 10 trials x 4 planners.
+# The thesis's grasping experiment (Table 4.4) in simulation: 5 objects x 20 trials x 4 planners,
+# plus the ablation steps from paper to default.
 bench: $(STAMP)
-	MPLBACKEND=Agg $(BIN)/contourgrasp bench --objects can,case,bottle,stone1,stone2 --trials 10 \
-		--planners paper,default,centroid-principal-axis,random --out bench-output
+	MPLBACKEND=Agg $(BIN)/contourgrasp bench --objects can,case,bottle,stone1,stone2 --trials 20 \
+		--planners paper,default,centroid-principal-axis,random --ablation --out bench-output
 
 clean:
 	rm -rf $(VENV) demo-output bench-output .pytest_cache

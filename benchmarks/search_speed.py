@@ -7,12 +7,15 @@ For every example contour and hand preset, in one process, on one core:
 (b) the library (``contourgrasp.synthesis.synthesize``) on the thesis grid;
 (c) the library on the dense grid (xy_step 0.01 m, yaw_step 1 deg, D_max 0.15 m: 31 x 31 x 360 =
     345,960 poses);
-(d) "dense + refinement": the library has no continuous refinement of the pose yet, so that row says
-    so instead of inventing a figure.
+(d) the library on the dense grid followed by its continuous refinement (``synthesize(refine=True)``:
+    a bounded compass search in x, y, yaw from the best distinct grid poses on the exact cost); the
+    row gives the refined cost and its gain over the dense grid's best.
 
 Library times are the median of ``--runs`` calls after one untimed warm-up call per grid (so numba's
 JIT compilation / cache loading is excluded); the reference is run once (it takes minutes per case).
-A plan's time includes the EFD fit, the grid screen and the exact re-evaluation of the best poses.
+A plan's time includes the EFD fit, the grid screen and the exact re-evaluation of the best poses (and,
+for (d), the refinement); the median of each stage (``timing_ms``) of the thesis-grid plans is printed
+per case.
 Peak memory of a library call is measured by ``tracemalloc`` in a separate, untimed call (it traces
 Python, numpy and numba-runtime allocations, not the interpreter's or the libraries' static memory);
 the process's ``ru_maxrss`` is printed at the end as well.
@@ -109,6 +112,12 @@ class LibResult:
     infeasible: str | None = None
     peak_bytes: int = 0
     size: int = 0
+    stages: list[dict] = field(default_factory=list)  # timing_ms of the timed runs
+
+    def stage_medians(self) -> str:
+        if not self.stages:
+            return "no plan"
+        return ", ".join(f"{k} {statistics.median(s[k] for s in self.stages):.2f}" for k in self.stages[0]) + " ms"
 
     @property
     def median(self) -> float:
@@ -124,11 +133,11 @@ class RefResult:
     size: int
 
 
-def run_library(contour, hand, grid: dict, runs: int) -> LibResult:
+def run_library(contour, hand, grid: dict, runs: int, refine: bool = False) -> LibResult:
     out = LibResult(size=grid_size(grid))
 
     def call():
-        return synthesis.synthesize(contour, hand, d_min=D_MIN, **grid)
+        return synthesis.synthesize(contour, hand, d_min=D_MIN, refine=refine, **grid)
 
     try:  # warm-up: numba compilation / cache loading, first-touch of every code path
         out.plan = call()
@@ -137,7 +146,8 @@ def run_library(contour, hand, grid: dict, runs: int) -> LibResult:
     for _ in range(runs):
         start = time.perf_counter()
         try:
-            call()
+            plan = call()
+            out.stages.append(plan.timing_ms)
         except cg.NoFeasibleGrasp:
             pass
         out.times.append(time.perf_counter() - start)
@@ -259,6 +269,7 @@ class Case:
     hand: str
     thesis: LibResult
     dense: LibResult
+    refined: LibResult
     ref: RefResult | None
     verdict: str = ""
     notes: list[str] = field(default_factory=list)
@@ -343,8 +354,15 @@ def table(cases: list[Case], machine_tag: str, runs: int) -> list[str]:
             rows.append(f"| {machine_tag} | {name} | {label} ({n}), median of {runs} | {fmt_time(res.median)} "
                         f"| {fmt_rate(n, res.median)} | {cost} | {diff} | {speed} | "
                         f"{res.peak_bytes / 2**20:.1f} MiB |")
-        rows.append(f"| {machine_tag} | {name} | dense + refinement | n/a (no continuous refinement yet) "
-                    f"| — | — | — | — | — |")
+        res = c.refined
+        if res.infeasible:
+            cost = "no feasible grasp"
+        else:
+            r = res.plan.refinement
+            cost = f"{r.cost:.6f} (gain {r.gain:.6f} over the dense grid's {r.grid_cost:.6f})"
+        rows.append(f"| {machine_tag} | {name} | library, dense ({dense_n}) + refinement, median of {runs} "
+                    f"| {fmt_time(res.median)} | {fmt_rate(dense_n, res.median)} | {cost} | — | — | "
+                    f"{res.peak_bytes / 2**20:.1f} MiB |")
     return rows
 
 
@@ -365,6 +383,16 @@ def targets(cases: list[Case]) -> list[str]:
     out.append(f"- dense grid <= {TARGET_DENSE_MS:.0f} ms per plan: {'MET' if n_ok == len(cases) else 'NOT MET'} "
                f"(met in {n_ok}/{len(cases)} cases; slowest {c.contour} / {c.hand}: {t * 1e3:.1f} ms; "
                f"median over cases {statistics.median(x.dense.median for x in cases) * 1e3:.1f} ms)")
+    gained = [c for c in cases if not c.refined.infeasible]
+    if gained:
+        gains = [c.refined.plan.refinement.gain for c in gained]
+        relative = [c.refined.plan.refinement.gain / abs(c.refined.plan.refinement.grid_cost) for c in gained]
+        c, t = worst(lambda c: c.refined.median)
+        out.append(f"- (d) dense grid + continuous refinement (no target): gains in {sum(g > 0 for g in gains)}/"
+                   f"{len(gained)} cases, median {statistics.median(gains):.4g} ({statistics.median(relative):.2%} of "
+                   f"the dense grid's best cost), largest {max(gains):.4g} ({max(relative):.2%}); time median "
+                   f"{statistics.median(x.refined.median for x in cases) * 1e3:.1f} ms, slowest {c.contour} / "
+                   f"{c.hand}: {t * 1e3:.1f} ms")
     with_ref = [c for c in cases if c.ref is not None]
     if with_ref:
         speedups = [(c.ref.time / c.thesis.median, c) for c in with_ref]
@@ -425,7 +453,8 @@ def main(argv=None) -> int:
           f"dense = xy 0.01 m, yaw 1 deg, D_max 0.15 m ({grid_size(DENSE)} poses); D_min {D_MIN} m; 4 harmonics, "
           "paper curvature.")
     print(f"Library: contourgrasp.synthesis.synthesize (EFD fit + compiled grid screen + exact re-evaluation of the "
-          f"best {max(tol.REFINE_CANDIDATES, 40)} screened poses), median of {args.runs} runs after 1 untimed warm-up "
+          f"best {max(tol.REFINE_CANDIDATES, 40)} screened poses; (d) adds refine=True: compass search from the best "
+          f"{tol.REFINE_STARTS} distinct poses), median of {args.runs} runs after 1 untimed warm-up "
           "call per grid (numba JIT / cache loading excluded).")
     print("Reference: benchmarks/reference_nested.reference_search (scipy L-BFGS-B per finger per pose), 1 run, "
           f"thesis grid only, hands: {', '.join(sorted(ref_hands)) or 'none'}.")
@@ -441,12 +470,13 @@ def main(argv=None) -> int:
             log(f"[{time.strftime('%H:%M:%S')}] {contour_name} / {hand_name}: library (load {load()}) ...")
             thesis = run_library(contour, hand, THESIS, args.runs)
             dense = run_library(contour, hand, DENSE, args.runs)
+            refined = run_library(contour, hand, DENSE, args.runs, refine=True)
             ref = None
             if hand_name in ref_hands:
                 log(f"[{time.strftime('%H:%M:%S')}] {contour_name} / {hand_name}: reference (load {load()}) ...")
                 ref = run_reference(contour, hand)
                 log(f"    reference took {ref.time:.0f} s")
-            case = Case(contour_name, hand_name, thesis, dense, ref)
+            case = Case(contour_name, hand_name, thesis, dense, refined, ref)
             compare(case, contour, hand)
             cases.append(case)
 
@@ -475,6 +505,11 @@ def main(argv=None) -> int:
             parts.append("dense: no feasible grasp")
         else:
             parts.append(f"dense best {fmt_pose(c.dense.plan.pose)}, {c.dense.plan.feasible_poses} feasible")
+        if not c.refined.infeasible:
+            r = c.refined.plan.refinement
+            parts.append(f"refinement gained {r.gain:.6g} ({r.grid_cost:.6f} -> {r.cost:.6f}), best "
+                         f"{fmt_pose(c.refined.plan.pose)}")
+        parts.append(f"thesis-grid stages (median): {lib.stage_medians()}")
         if c.ref is not None:
             parts.append("reference: no feasible pose" if c.ref.pose is None else
                          f"reference best {fmt_pose(c.ref.pose)}, {c.ref.feasible} feasible poses")

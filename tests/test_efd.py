@@ -2,8 +2,11 @@ import warnings
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from contourgrasp import ContourError, UnitWarning, efd, example_contour
+from contourgrasp import tolerances as tol
 from conftest import disc, rotate
 
 
@@ -345,3 +348,24 @@ def test_millimetre_noise_keeps_the_count_moderate(name):
         assert counts == [8, 8, 8]
     if name == "stone1":
         assert max(counts) <= 6
+
+
+def _crossings_numpy(p):
+    """All crossing pairs (i < j, non-adjacent) by the (n, n) orientation arrays: the oracle of the compiled test."""
+    n, (a, b) = len(p), (p, np.roll(p, -1, axis=0))
+    d = b - a
+    o1 = d[:, None, 0] * (a[None, :, 1] - a[:, None, 1]) - d[:, None, 1] * (a[None, :, 0] - a[:, None, 0])
+    o2 = d[:, None, 0] * (b[None, :, 1] - a[:, None, 1]) - d[:, None, 1] * (b[None, :, 0] - a[:, None, 0])
+    eps = tol.COLLINEAR * float(np.max(np.ptp(p, axis=0))) ** 2
+    straddles = ((o1 > eps) & (o2 < -eps)) | ((o1 < -eps) & (o2 > eps))
+    i, j = np.nonzero(np.triu(straddles & straddles.T, k=2))
+    keep = ~((i == 0) & (j == n - 1))
+    return list(zip(i[keep].tolist(), j[keep].tolist()))
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(4, 40), st.integers(0, 2**32 - 1))
+def test_first_self_intersection_matches_the_full_pairwise_test(n, seed):
+    points = np.random.default_rng(seed).uniform(-0.05, 0.05, size=(n, 2))  # random polygons mostly cross
+    pairs = _crossings_numpy(points)
+    assert efd.first_self_intersection(points) == (pairs[0] if pairs else None)

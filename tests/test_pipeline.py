@@ -77,7 +77,7 @@ def test_real_frames_plan_feasibly_on_the_object(index):
 
 def test_plan_with_a_user_mask(tmp_path):
     frame = bundled()
-    auto = cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, "three-finger", **FAST)
+    auto = cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, "three-finger", planner="default", **FAST)
     mask_path = tmp_path / "mask.png"
     cv2.imwrite(str(mask_path), auto.segmentation.mask.astype(np.uint8) * 255)
     code = main(["plan", "--depth", str(FRAME / "depth_0.npy"), "--intrinsics", str(FRAME / "primesense_overhead_color.intr"),

@@ -7,7 +7,8 @@ from hypothesis import strategies as st
 from matplotlib.path import Path as MplPath
 
 import contourgrasp as cg
-from contourgrasp import ContourError, NoFeasibleGrasp, efd, synthesis
+from contourgrasp import ContourError, NoFeasibleGrasp, _kernels, efd, synthesis
+from contourgrasp.io.plan_file import plan_to_dict
 from conftest import disc, rotate
 
 FINE = {"xy_step": 0.02, "yaw_step": math.radians(4)}
@@ -117,6 +118,72 @@ def test_compiled_grid_screen_matches_the_numpy_inner_problem(hand):
     # the curves, which the curved thumb's gain of 100 on curvature amplifies.
     has_arc = any(isinstance(f.trajectory, cg.Arc) for f in hand.fingers)
     np.testing.assert_allclose(screen.cost[both], exact.cost[both], rtol=1e-2 if has_arc else 2e-3, atol=0.05)
+
+
+def test_compiled_pose_list_matches_the_numpy_inner_problem():
+    """evaluate_poses's polygon stage (every chord against every edge, compiled) is first_touch's answer."""
+    for hand in map(cg.load_hand, cg.preset_names()):
+        model = efd.fit(cg.example_contour("peanut"))
+        t, polygon = efd.sample(model)
+        rng = np.random.default_rng(2)
+        poses = np.c_[rng.uniform(-0.12, 0.12, (300, 2)), rng.uniform(0, 2 * math.pi, 300)]
+        seg = hand.segments()
+        lam, t_hit, point, inside = _kernels.pose_first_touch(
+            polygon, t, model.T, poses, seg.start, seg.end - seg.start, seg.finger, seg.lam0,
+            synthesis._first_chords(seg, len(hand.fingers)), len(hand.fingers), cg.tolerances.PARALLEL)
+        ref_lam, ref_t, ref_point, ref_inside = synthesis.first_touch(polygon, t, model.T, seg, len(hand.fingers), poses)
+        touching = np.isfinite(ref_lam)
+        assert touching.any() and ref_inside.any()
+        np.testing.assert_array_equal(inside, ref_inside)
+        np.testing.assert_array_equal(np.isfinite(lam), touching)
+        np.testing.assert_allclose(lam[touching], ref_lam[touching], atol=1e-12)
+        np.testing.assert_allclose(t_hit[touching], ref_t[touching], atol=1e-12)
+        np.testing.assert_allclose(point[touching], ref_point[touching], atol=1e-12)
+
+
+def test_curved_thumb_cells_match_brute_force_on_a_large_and_a_tiny_object():
+    """The arc's later chords look edges up in cells: objects much larger and smaller than a cell."""
+    hand = cg.load_hand("five-finger-curved-thumb")
+    grid = synthesis.SearchGrid(xy_step=0.03, yaw_step=math.radians(9))
+    # turned off the grid's axes: a symmetric disc would put rays exactly through polygon vertices
+    for outline in (rotate(disc(0.14, n=90) * [1.0, 0.6], 0.3), rotate(disc(0.012, n=40) * [1.0, 0.7], 0.3)):
+        model = efd.fit(outline)
+        screen = synthesis.screen_grid(model, hand, grid)
+        t, polygon = efd.sample(model)
+        lam, t_hit, _, inside = synthesis.first_touch(polygon, t, model.T, hand.segments(), 5, screen.poses)
+        assert np.isfinite(lam[:, 0]).any()
+        np.testing.assert_array_equal(screen.start_inside, inside)
+        np.testing.assert_array_equal(screen.touching, np.isfinite(lam))
+        np.testing.assert_allclose(screen.lam[screen.touching], lam[np.isfinite(lam)], atol=1e-12)
+        np.testing.assert_allclose(screen.t[screen.touching], t_hit[np.isfinite(lam)], atol=1e-12)
+
+
+@pytest.mark.parametrize("mode", efd.CURVATURE_MODES)
+def test_screen_curvature_tables_match_the_curve(mode):
+    """Magnitude and turning sign interpolated apart: no smearing across the paper curvature's jumps."""
+    model = efd.fit(cg.example_contour("peanut"))
+    t = np.random.default_rng(3).uniform(0, model.T, (2000, 1))
+    table_t = np.linspace(0.0, model.T, cg.tolerances.CURVATURE_TABLE, endpoint=False)
+    d1, d2 = efd.evaluate(model, table_t, 1), efd.evaluate(model, table_t, 2)
+    table = _kernels.interpolate_curvature(np.abs(efd.curvature(model, table_t, mode)),
+                                           d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0], t, model.T)[:, 0]
+    exact = efd.curvature(model, t[:, 0], mode)
+    assert (exact < 0).any() and (exact > 0).any()
+    assert np.mean(np.sign(table) == np.sign(exact)) > 0.998
+    same = np.sign(table) == np.sign(exact)
+    np.testing.assert_allclose(table[same], exact[same], rtol=1e-3, atol=2e-3 * np.abs(exact).max())
+
+
+def test_nearest_point_segment_matches_numpy():
+    rng = np.random.default_rng(4)
+    points, starts, vectors = rng.normal(size=(30, 2)), rng.normal(size=(20, 2)), rng.normal(size=(20, 2))
+    w = points[:, None] - starts[None]
+    s = np.clip(np.einsum("nsi,si->ns", w, vectors) / np.sum(vectors**2, axis=1), 0, 1)
+    gap = np.linalg.norm(w - s[..., None] * vectors[None], axis=2)
+    i, k = np.unravel_index(np.argmin(gap), gap.shape)
+    got = _kernels.nearest_point_segment(points, starts, vectors)
+    assert got[:2] == (i, k)
+    assert got[2:] == pytest.approx((s[i, k], gap[i, k]), abs=1e-14)
 
 
 def test_start_inside_matches_point_in_polygon():
@@ -247,3 +314,80 @@ def test_random_star_polygons_give_finite_plans_or_documented_errors(polygon, ha
     assert all(np.isfinite([plan.cost.total, plan.cost.curvature, plan.cost.ratio, plan.cost.miss]))
     for f in plan.fingers:
         assert np.all(np.isfinite(f.grasp_point)) and np.isfinite(f.curvature) and np.isfinite(f.distance)
+
+
+def _grid_best(outline, hand, top=4, **grid):
+    """The model and the exact evaluation of the ``top`` distinct best poses of a grid."""
+    model = efd.fit(outline)
+    grid = synthesis.SearchGrid(**grid)
+    screen = synthesis.screen_grid(model, hand, grid)
+    best = synthesis._reevaluate_best(model, hand, screen, 40, "paper", grid.d_min, synthesis.Safeguards())
+    poses = best.poses[synthesis._distinct_best(best, grid, top)]
+    return model, grid, synthesis.evaluate_poses(model, hand, poses, d_min=grid.d_min)
+
+
+@pytest.mark.parametrize("obj, hand", [("stone1", "three-finger"), ("bottle", "five-finger-linear"),
+                                       ("can", "five-finger-curved-thumb")])
+def test_refinement_is_never_worse_stays_feasible_and_in_its_box(obj, hand):
+    hand = cg.load_hand(hand)
+    model, grid, start = _grid_best(cg.example_contour(obj), hand, xy_step=0.05, yaw_step=math.radians(6))
+    step = (grid.xy_step, grid.yaw_step)
+    refined = synthesis.refine_poses(model, hand, start.poses, step=step, d_max=grid.d_max, d_min=grid.d_min)
+    assert start.feasible.all() and refined.feasible.all()
+    assert (refined.cost <= start.cost).all()
+    moved = refined.poses - start.poses
+    assert (np.abs(moved) <= np.array([grid.xy_step, grid.xy_step, grid.yaw_step]) + 1e-12).all()
+    assert (np.abs(refined.poses[:, :2] - model.locus) <= np.array(grid.d_max) + 1e-12).all()
+    # the costs are evaluate_poses's own at the refined poses
+    again = synthesis.evaluate_poses(model, hand, refined.poses, d_min=grid.d_min)
+    np.testing.assert_allclose(again.cost, refined.cost, rtol=1e-12)
+
+
+def test_refinement_applies_the_evaluation_keywords():
+    """Constraints passed through to evaluate_poses bind the refined poses: here a larger D_min."""
+    hand = cg.load_hand("three-finger")
+    model, grid, start = _grid_best(cg.example_contour("case"), hand, xy_step=0.05, yaw_step=math.radians(6),
+                                    d_min=0.03)
+    refined = synthesis.refine_poses(model, hand, start.poses, step=(0.05, math.radians(6)), d_min=0.03)
+    assert refined.feasible.all()
+    assert np.nanmin(refined.start_distance[refined.touching]) >= 0.03
+    loose = synthesis.refine_poses(model, hand, start.poses, step=(0.05, math.radians(6)), d_min=0.0)
+    assert loose.cost.min() <= refined.cost.min()
+
+
+@pytest.mark.parametrize("option, value", [("step", (0.0, 0.1)), ("step", (0.05,)), ("halvings", -1),
+                                           ("rounds", 2.5), ("d_max", -0.1)])
+def test_refinement_refuses_bad_options(option, value):
+    model = efd.fit(cg.example_contour("can"))
+    with pytest.raises(cg.InputError):
+        synthesis.refine_poses(model, cg.load_hand("three-finger"), [[0.0, 0.0, 0.0]], **{option: value})
+
+
+def test_refinement_finds_the_off_grid_optimum_of_a_coarse_grid():
+    """On a coarse grid the optimum lies between grid poses: refinement gains, and reaches a fine grid's cost."""
+    outline = cg.example_contour("can")
+    coarse = cg.synthesize(outline, "three-finger", xy_step=0.05, yaw_step=math.radians(10), refine=True)
+    fine = cg.synthesize(outline, "three-finger", xy_step=0.01, yaw_step=math.radians(2))
+    r = coarse.refinement
+    assert r.cost == coarse.cost.total < r.grid_cost
+    assert r.gain == pytest.approx(r.grid_cost - r.cost) and r.gain > 0
+    assert coarse.cost.total <= fine.cost.total + 1e-9
+    on_grid = np.round((np.asarray(coarse.pose[:2]) - coarse.efd.locus) / 0.05, 6)
+    assert not np.all(on_grid == np.round(on_grid))
+
+
+def test_refined_plan_reports_the_grid_best_stages_and_ranked_alternatives():
+    plan = cg.synthesize(cg.example_contour("stone1"), "three-finger", yaw_step=math.radians(6), refine=True)
+    plain = cg.synthesize(cg.example_contour("stone1"), "three-finger", yaw_step=math.radians(6))
+    assert plain.refinement is None and plain.timing_ms["refine"] == 0
+    assert set(plan.timing_ms) == {"efd", "search", "exact", "refine", "total"}
+    assert plan.refinement.grid_cost == pytest.approx(plain.cost.total, rel=1e-12)
+    np.testing.assert_allclose(plan.refinement.grid_pose, plain.pose)
+    assert plan.cost.total <= plain.cost.total
+    costs = [a.cost.total for a in plan.alternatives]
+    assert costs == sorted(costs) and len(costs) == 10
+    np.testing.assert_allclose(plan.alternatives[0].pose, plan.pose)
+    assert plan_to_dict(plain)["refinement"] is None
+    data = plan_to_dict(plan)["refinement"]
+    assert (data["grid_cost"], data["cost"], data["gain"]) == (plan.refinement.grid_cost, plan.cost.total,
+                                                              plan.refinement.gain)

@@ -4,8 +4,8 @@ Runs the `contourgrasp` command exactly as a user would and writes, to the
 output folder (default demo-output/): bar_clamp-plan.json and .png, the full
 RGB-D pipeline (`contourgrasp plan`) on the bundled frame examples/bar_clamp;
 <contour>-<hand>.json and .png for each pair, efd-<contour>.png (the thesis's Figure 4.5) for each contour, and
-summary.md, a table of what was planned. Grid: XY_STEP below, otherwise the
-thesis's settings (2 deg, D_max 0.15 m, D_min 0.015 m, 4 harmonics, paper curvature).
+summary.md, a table of what was planned. Every plan uses the command's default
+planner, `default` (src/contourgrasp/data/planners/default.toml).
 """
 
 import contextlib
@@ -17,10 +17,6 @@ from pathlib import Path
 from contourgrasp.cli import main as contourgrasp
 from contourgrasp.io.contour_file import example_names
 from contourgrasp.io.hand_file import preset_names
-
-# The thesis's 0.05 m grid leaves the Table 4.3 hand, whose reference point lies
-# 0.14 m from its grasp centre, only a few dozen feasible poses; 0.02 m shows the method better.
-XY_STEP = 0.02
 
 
 def run(*argv) -> tuple[int, str]:
@@ -41,8 +37,7 @@ def main(out: Path) -> int:
             return code
         for hand in preset_names():
             stem = out / f"{contour}-{hand}"
-            code, err = run("synth", "--contour", f"example:{contour}", "--hand", hand, "--xy-step", XY_STEP,
-                            "--out", f"{stem}.json", "--plot", f"{stem}.png")
+            code, err = run("synth", "--contour", f"example:{contour}", "--hand", hand, "--out", f"{stem}.json", "--plot", f"{stem}.png")
             if code == 3:
                 rows.append(f"| {contour} | {hand} | {err.removeprefix('contourgrasp: ')} |||||||")
                 continue
@@ -60,8 +55,7 @@ def main(out: Path) -> int:
     frame = Path(__file__).resolve().parents[1] / "examples" / "bar_clamp"
     code, err = run("plan", "--rgb", frame / "color_0.png", "--depth", frame / "depth_0.npy",
                     "--intrinsics", frame / "primesense_overhead_color.intr",
-                    "--extrinsics", frame / "primesense_overhead_to_world.tf", "--xy-step", XY_STEP,
-                    "--out", out / "bar_clamp-plan.json", "--plot", out / "bar_clamp-plan.png")
+                    "--extrinsics", frame / "primesense_overhead_to_world.tf", "--out", out / "bar_clamp-plan.json", "--plot", out / "bar_clamp-plan.png")
     if code:
         print(err, file=sys.stderr)
         return code

@@ -12,6 +12,7 @@ import math
 import sys
 import time
 import warnings
+from pathlib import Path
 
 import numpy as np
 
@@ -19,6 +20,7 @@ from . import __version__, efd, synthesize
 from .errors import InputError, NoFeasibleGrasp
 from .io.contour_file import example_contour, example_names, read_contour
 from .io.hand_file import load_hand, preset_names
+from .io.planner_file import PERCEPTION_OPTIONS, load_planner, planner_names
 from .io.plan_file import atomic_outputs, plan_to_dict, write_json
 
 EXIT_OK, EXIT_INPUT, EXIT_INFEASIBLE = 0, 2, 3
@@ -84,8 +86,8 @@ def _parser() -> argparse.ArgumentParser:
                       help="meters per unit of integer depth images (default 0.001: millimetres)")
     plan.add_argument("--segment", choices=("auto", "rgb", "depth"), default="auto")
     plan.add_argument("--mask", help="binary image of the object: skips segmentation")
-    plan.add_argument("--depth-mode", choices=("max", "plane"), default="max",
-                      help="contour plane: 'max' (thesis eq 3.1-3.2) or the object's top 'plane'")
+    plan.add_argument("--depth-mode", choices=("max", "plane"),
+                      help="contour plane: 'max' (thesis eq 3.1-3.2) or the object's top 'plane' (default: the planner's)")
     plan.add_argument("--no-fill-holes", action="store_true", help="do not fill small depth holes")
     plan.add_argument("--approach-offset", type=float, default=0.01, help="added to the nearest depth, m")
     plan.add_argument("--standoff", type=_non_negative_float, default=0.10, help="pre-grasp distance, m")
@@ -103,16 +105,32 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _harmonics(text: str):
+    return text if text == "adaptive" else _positive_int(text)
+
+
 def _add_synthesis_options(parser) -> None:
     parser.add_argument("--hand", default="five-finger-linear", help="preset name or hand TOML file")
-    parser.add_argument("--harmonics", type=_positive_int, default=4)
-    parser.add_argument("--curvature", choices=efd.CURVATURE_MODES, default="paper")
-    parser.add_argument("--xy-step", type=_positive_float, default=0.05, help="grid step in x and y, m")
-    parser.add_argument("--yaw-step-deg", type=_positive_float, default=2.0, help="grid step in yaw, degrees")
-    parser.add_argument("--d-max", type=_non_negative_float, nargs="+", default=[0.15], metavar="D",
+    parser.add_argument("--planner", default="default",
+                        help=f"planner preset ({', '.join(planner_names())}) or planner TOML file; "
+                             "the options below override its settings")
+    parser.add_argument("--harmonics", type=_harmonics, help="EFD harmonics, or 'adaptive'")
+    parser.add_argument("--curvature", choices=efd.CURVATURE_MODES)
+    parser.add_argument("--xy-step", type=_positive_float, help="grid step in x and y, m")
+    parser.add_argument("--yaw-step-deg", type=_positive_float, help="grid step in yaw, degrees")
+    parser.add_argument("--d-max", type=_non_negative_float, nargs="+", metavar="D",
                         help="D_max (one value, or x and y), m")
-    parser.add_argument("--d-min", type=_non_negative_float, default=0.015, help="D_min, m")
+    parser.add_argument("--d-min", type=_non_negative_float, help="D_min, m")
+    parser.add_argument("--finger-thickness", action=argparse.BooleanOptionalAction,
+                        help="fingers are discs of their hand-file radius")
+    parser.add_argument("--clearance", type=_non_negative_float, help="free distance around open fingertips, m")
+    parser.add_argument("--friction", type=_non_negative_float, help="friction coefficient of the grasp quality")
+    parser.add_argument("--require-closure", action=argparse.BooleanOptionalAction,
+                        help="only poses whose grasp points are in force closure")
+    parser.add_argument("--quality-gain", type=_non_negative_float, help="cost term -gain * epsilon")
     parser.add_argument("--top-k", type=_positive_int, default=10, help="ranked distinct poses to report")
+    parser.add_argument("--refine", action=argparse.BooleanOptionalAction,
+                        help="refine the best grid poses continuously (x, y, yaw) and report the gain")
     parser.add_argument("--out", help="write the plan JSON here (default: print it)")
     parser.add_argument("--plot", help="write the plan picture (PNG) here")
 
@@ -123,11 +141,13 @@ def _add_bench_parser(sub) -> None:
     objects.add_argument("--objects", default="can,case,bottle,stone1,stone2",
                          help="comma-separated names of the simulated objects (default: the thesis's five)")
     objects.add_argument("--mesh", nargs="+", metavar="FILE", help="OBJ/STL mesh files in meters, z up, instead")
-    bench.add_argument("--trials", type=_positive_int, default=10, help="trials per object and planner")
+    bench.add_argument("--trials", type=_positive_int, default=20, help="trials per object and planner")
     bench.add_argument("--seed", type=_non_negative_int, default=0, help="trial t uses seed SEED + t")
     bench.add_argument("--hand", default="five-finger-linear", help="preset name or hand TOML file (ray fingers)")
     bench.add_argument("--planners", default="paper,default,centroid-principal-axis,random",
-                       help="comma-separated planner names")
+                       help="comma-separated planner names: presets, baselines, ablation steps or planner TOML files")
+    bench.add_argument("--ablation", action="store_true",
+                       help="also run every step of the ablation from paper to default")
     bench.add_argument("--out", default="bench-output", help="output folder (created if missing)")
     bench.add_argument("--noise", action=argparse.BooleanOptionalAction, default=True,
                        help="depth sensor noise in the planner's picture")
@@ -140,18 +160,31 @@ def _add_calibrate_parser(sub) -> None:
     calibrate.add_argument("--out", help="write the hand TOML with the calibrated virtual starts here")
 
 
-def _synthesis_options(args) -> dict:
-    if len(args.d_max) > 2:
+def _plan_options(args) -> dict:
+    """The planner's options of ``plan_grasp``, overridden by the options given on the command line."""
+    if args.d_max is not None and len(args.d_max) > 2:
         raise InputError(f"--d-max takes one or two values, got {len(args.d_max)}")
-    return {
+    given = {
         "harmonics": args.harmonics,
         "curvature": args.curvature,
         "xy_step": args.xy_step,
-        "yaw_step": math.radians(args.yaw_step_deg),
-        "d_max": tuple(args.d_max) if len(args.d_max) == 2 else args.d_max[0],
+        "yaw_step": None if args.yaw_step_deg is None else math.radians(args.yaw_step_deg),
+        "d_max": None if args.d_max is None else tuple(args.d_max) if len(args.d_max) == 2 else args.d_max[0],
         "d_min": args.d_min,
+        "finger_thickness": args.finger_thickness,
+        "clearance": args.clearance,
+        "friction": args.friction,
+        "require_closure": args.require_closure,
+        "quality_gain": args.quality_gain,
+        "depth_mode": getattr(args, "depth_mode", None),
         "top_k": args.top_k,
+        "refine": args.refine,
     }
+    return load_planner(args.planner).plan_options | {k: v for k, v in given.items() if v is not None}
+
+
+def _synthesis_options(args) -> dict:
+    return {k: v for k, v in _plan_options(args).items() if k not in PERCEPTION_OPTIONS}
 
 
 def _write_outputs(args, data: dict, figure, summary: str) -> None:
@@ -206,12 +239,11 @@ def _plan(args) -> int:
         load_hand(args.hand),
         segment=args.segment,
         mask=None if args.mask is None else read_mask(args.mask),
-        depth_mode=args.depth_mode,
         fill_holes=not args.no_fill_holes,
         approach_offset=args.approach_offset,
         standoff=args.standoff,
         T_base_camera=None if args.extrinsics is None else read_extrinsics(args.extrinsics),
-        **_synthesis_options(args),
+        **_plan_options(args),
     )
 
     def figure():
@@ -223,12 +255,28 @@ def _plan(args) -> int:
     return EXIT_OK
 
 
+def _mesh_names(paths) -> list[str]:
+    """Object names of mesh files: the file's stem; its folder's name where stems repeat (YCB's model files);
+    folder-stem where the stem is a thesis object's name (whose Table 4.4 rate it must not take)."""
+    from .sim.objects import THESIS_OBJECTS
+
+    stems = [Path(p).stem for p in paths]
+    names = [Path(p).parent.name if stems.count(stem) > 1 else stem for p, stem in zip(paths, stems, strict=True)]
+    return [f"{Path(p).parent.name}-{n}" if n in THESIS_OBJECTS else n for p, n in zip(paths, names, strict=True)]
+
+
 def _bench(args) -> int:
     from .sim import bench, mesh_object
 
     started = time.perf_counter()
-    objects = [mesh_object(path) for path in args.mesh] if args.mesh else bench.thesis_objects(_names(args.objects))
-    setup = bench.Bench(objects=objects, planners=_names(args.planners), trials=args.trials, seed=args.seed,
+    objects = [mesh_object(path, name=name) for path, name in zip(args.mesh, _mesh_names(args.mesh), strict=True)] \
+        if args.mesh else bench.thesis_objects(_names(args.objects))
+    planners = _names(args.planners)
+    if args.ablation:
+        from .sim.planners import ablation_planners
+
+        planners += [p.name for p in ablation_planners()[1:-1] if p.name not in planners]
+    setup = bench.Bench(objects=objects, planners=planners, trials=args.trials, seed=args.seed,
                         hand=load_hand(args.hand), noise=args.noise)
     with bench.console_progress(setup.size) as progress:
         results = bench.run_bench(setup, progress)

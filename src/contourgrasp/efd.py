@@ -54,6 +54,7 @@ import numpy as np
 import pyefd
 
 from . import tolerances as tol
+from ._kernels import first_crossing
 from .errors import ContourError, InputError, UnitWarning
 
 CurvatureMode = Literal["paper", "geometric"]
@@ -159,26 +160,10 @@ def first_self_intersection(points: np.ndarray) -> tuple[int, int] | None:
     points : (n, 2) float
         Polygon vertices; edge i runs from point i to point i+1 (mod n).
     """
-    p = np.asarray(points, dtype=float)
-    n = len(p)
-    a, b = p, np.roll(p, -1, axis=0)
-    d = b - a
-
-    def cross(u, v):
-        return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
-
-    # Orientation of each edge's end points relative to every other edge.
-    o1 = cross(d[:, None], a[None, :] - a[:, None])
-    o2 = cross(d[:, None], b[None, :] - a[:, None])
+    p = np.ascontiguousarray(points, dtype=float)
     eps = tol.COLLINEAR * float(np.max(np.ptp(p, axis=0))) ** 2
-    straddles = ((o1 > eps) & (o2 < -eps)) | ((o1 < -eps) & (o2 > eps))
-    crosses = straddles & straddles.T
-    i, j = np.triu_indices(n, k=2)
-    keep = ~((i == 0) & (j == n - 1))
-    hits = np.flatnonzero(crosses[i[keep], j[keep]])
-    if hits.size == 0:
-        return None
-    return int(i[keep][hits[0]]), int(j[keep][hits[0]])
+    i, j = first_crossing(p, eps)
+    return None if i < 0 else (int(i), int(j))
 
 
 def fit(points, harmonics: int = 4, *, validate: bool = True) -> EFD:

@@ -116,6 +116,9 @@ class Finger:
         Gains on the curvature and ratio costs (eq 3.34).
     required : bool
         A pose is infeasible when this finger misses the object.
+    radius : float
+        Half the finger's width, m: the fingertip is a disc of this radius
+        (used by the planner's finger-thickness check, not by the thesis's).
     """
 
     name: str
@@ -126,8 +129,11 @@ class Finger:
     alpha: float = 1.0
     beta: float = 0.0
     required: bool = False
+    radius: float = 0.0
 
     def __post_init__(self):
+        if not self.radius >= 0:
+            raise ValueError(f"finger {self.name!r}: radius must be >= 0, got {self.radius}")
         if not self.travel > 0:
             raise ValueError(f"finger {self.name!r}: travel must be > 0, got {self.travel}")
         if isinstance(self.trajectory, Arc) and max(self.travel, abs(self.virtual_start)) >= self.trajectory.perimeter:

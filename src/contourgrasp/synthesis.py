@@ -33,26 +33,31 @@ Outer problem (eq 3.32-3.41)
     * miss: ``hand.miss_penalty`` per finger that closes on air.
 
 Search: :func:`screen_grid` evaluates every grid pose with a compiled kernel
-(contacts on the EFD polygon, curvature from a table); :func:`evaluate_poses`
-then solves the cheapest candidates exactly (numpy, Newton onto the curve).
-There is no Python loop per pose.
+(contacts on the EFD polygon, curvature from tables); :func:`evaluate_poses`
+then solves the cheapest candidates exactly (polygon contacts compiled, then
+Newton onto the curve, numpy). There is no Python loop per pose. Optionally
+(``synthesize(refine=True)``), :func:`refine_poses` leaves the grid: a bounded
+compass search in (x, y, yaw) from the best distinct grid poses, on the exact
+cost and under the same constraints.
 """
 
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import Literal
 
 import numpy as np
 
 from . import efd as efd_model
+from . import quality
 from . import tolerances as tol
 from .efd import EFD, CurvatureMode
 from .errors import InputError, NoFeasibleGrasp
-from ._kernels import grid_first_touch, ratio_cost_rows, score_poses
-from .hand import Hand, HandSegments, rotation, to_image
+from ._kernels import (grid_first_touch, interpolate_curvature, nearest_point_segment, pose_first_touch,
+                       ratio_cost_rows, score_poses)
+from .hand import Hand, HandSegments, Ray, rotation, to_image
 
 
 @dataclass(frozen=True)
@@ -103,6 +108,57 @@ class SearchGrid:
         return np.stack([x.ravel(), y.ravel(), yaw.ravel()], axis=1)
 
 
+@dataclass(frozen=True)
+class Safeguards:
+    """Constraints and a cost term beyond the thesis's, against the failures of its chapter 5.
+
+    All off (the default) is the thesis's problem. They act where contacts are
+    exact (:func:`evaluate_poses`): :func:`synthesize` screens the grid
+    without them, then applies them to the cheapest candidates, widening the
+    candidate set until one passes.
+
+    Attributes
+    ----------
+    finger_thickness : bool
+        Fingers are discs of their hand file's ``radius`` (failure 5, a finger
+        striking the object on the way). A pose is rejected when a fingertip
+        starts closer than ``radius + clearance`` to the contour, or when the
+        disc swept along its trajectory up to the grasp point meets the contour
+        farther than ``2 radius`` from the grasp point (the disc of a finger
+        meeting a flat side at up to ~60 deg from its normal touches within
+        that distance; beyond, it hits another part of the object first). A
+        finger that misses must clear the contour by ``radius`` all along.
+    clearance : float
+        Extra free distance around every open fingertip, m: the margin for the
+        open finger leaning over its path and for segmentation error.
+    friction : float
+        mu of the grasp quality (:mod:`contourgrasp.quality`).
+    require_closure : bool
+        Reject poses whose grasp points are not in 2-D force closure (failure 2,
+        "all grasping points on the same surface"; 6.1 item 2).
+    quality_gain : float
+        Cost term ``-quality_gain * epsilon`` (Ferrari-Canny L1, wrenches about
+        the EFD locus, torque over the contour's largest radius about it).
+    """
+
+    finger_thickness: bool = False
+    clearance: float = 0.0
+    friction: float = 0.5
+    require_closure: bool = False
+    quality_gain: float = 0.0
+
+    def __post_init__(self):
+        for name in ("clearance", "friction", "quality_gain"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value >= 0):
+                raise InputError(f"{name} must be a number >= 0, got {value!r}")
+
+    @property
+    def grades_quality(self) -> bool:
+        """Epsilon is needed for every candidate (not only the plan)."""
+        return self.require_closure or self.quality_gain > 0
+
+
 @dataclass(frozen=True, eq=False)
 class PoseEvaluation:
     """Inner-problem solutions and costs for many poses; arrays are (p,) or (p, n_fingers).
@@ -130,8 +186,12 @@ class PoseEvaluation:
         No fingertip starts inside the contour.
     reaches : (p,) bool
         Every required finger and at least ``min_touching`` fingers touch.
+    clear : (p,) bool
+        The fingers pass :class:`Safeguards` ``finger_thickness`` (all True when it is off).
+    epsilon : (p,) float
+        Ferrari-Canny epsilon of the grasp points (NaN where not computed).
     feasible : (p,) bool
-    cost_curvature, cost_ratio, cost_miss, cost : (p,) float
+    cost_curvature, cost_ratio, cost_miss, cost_quality, cost : (p,) float
     """
 
     poses: np.ndarray
@@ -145,21 +205,25 @@ class PoseEvaluation:
     start_inside: np.ndarray
     starts_outside: np.ndarray
     reaches: np.ndarray
+    clear: np.ndarray
+    epsilon: np.ndarray
     feasible: np.ndarray
     cost_curvature: np.ndarray
     cost_ratio: np.ndarray
     cost_miss: np.ndarray
+    cost_quality: np.ndarray
     cost: np.ndarray
 
 
 @dataclass(frozen=True)
 class Cost:
-    """The cost of a pose (eq 3.34) and its parts."""
+    """The cost of a pose (eq 3.34) and its parts (``quality``: :class:`Safeguards` ``quality_gain``)."""
 
     total: float
     curvature: float
     ratio: float
     miss: float
+    quality: float = 0.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -191,6 +255,30 @@ class Alternative:
     cost: Cost
 
 
+@dataclass(frozen=True)
+class Refinement:
+    """What the continuous refinement of :func:`synthesize` (``refine=True``) gained over the grid.
+
+    Attributes
+    ----------
+    grid_pose : (3,) float
+        The best grid pose (exactly evaluated), before refinement.
+    grid_cost : float
+        Its cost (eq 3.34).
+    cost : float
+        The plan's cost after refinement, never above ``grid_cost``.
+    """
+
+    grid_pose: tuple[float, float, float]
+    grid_cost: float
+    cost: float
+
+    @property
+    def gain(self) -> float:
+        """grid_cost - cost, >= 0."""
+        return self.grid_cost - self.cost
+
+
 @dataclass(frozen=True, eq=False)
 class GraspPlan:
     """The result of :func:`synthesize`.
@@ -214,7 +302,14 @@ class GraspPlan:
         Poses evaluated.
     feasible_poses : int
     timing_ms : dict
-        Wall time per stage, milliseconds.
+        Wall time per stage, milliseconds: ``efd`` (contour check and fit), ``search`` (grid
+        screen), ``exact`` (exact re-evaluation of the best screened poses), ``refine``
+        (continuous refinement, 0 without it) and ``total``.
+    refinement : Refinement or None
+        The grid's best and the gain of the continuous refinement; None without it.
+    safeguards : Safeguards
+    quality : contourgrasp.quality.GraspQuality
+        Force closure and Ferrari-Canny L1 epsilon of the grasp points (missed fingers excluded).
     """
 
     pose: np.ndarray
@@ -229,6 +324,9 @@ class GraspPlan:
     grid_size: int
     feasible_poses: int
     timing_ms: dict
+    refinement: Refinement | None
+    safeguards: Safeguards
+    quality: quality.GraspQuality
 
 
 def first_touch(
@@ -342,6 +440,7 @@ def evaluate_poses(
     curvature: CurvatureMode = "paper",
     d_min: float = 0.015,
     samples: int = tol.EFD_SAMPLES,
+    safeguards: Safeguards = Safeguards(),
 ) -> PoseEvaluation:
     """Solve the inner problem exactly and the outer cost for each pose (eq 3.22-3.41).
 
@@ -360,6 +459,8 @@ def evaluate_poses(
         D_min of eq 3.41, m.
     samples : int
         Points of the EFD polygon the fingers are intersected with first.
+    safeguards : Safeguards
+        Constraints and cost beyond the thesis's (default: none).
 
     Returns
     -------
@@ -369,14 +470,21 @@ def evaluate_poses(
     contour_t, contour = efd_model.sample(model, samples)
     segments = hand.segments()
     n_f = len(hand.fingers)
-    chunks = np.array_split(poses, max(1, math.ceil(len(poses) / tol.POSE_CHUNK)))
-    parts = [first_touch(contour, contour_t, model.T, segments, n_f, chunk) for chunk in chunks]
-    lam, t, point, start_inside = (np.concatenate(arrays) for arrays in zip(*parts))
+    lam, t, point, start_inside = pose_first_touch(
+        contour, contour_t, model.T, poses, segments.start, segments.end - segments.start, segments.finger,
+        segments.lam0, _first_chords(segments, n_f), n_f, tol.PARALLEL,
+    )
     touching = np.isfinite(lam)
-    t, lam, point = _refine(model, hand, poses, t, lam, point, touching, model.T / samples)
+    t, lam, point = _newton(model, hand, poses, t, lam, point, touching, model.T / samples)
     curv = np.full(lam.shape, np.nan)
     curv[touching] = efd_model.curvature(model, t[touching], curvature)
-    return _assemble(hand, poses, touching, lam, t, point, curv, start_inside, d_min)
+    clear = np.ones(len(poses), bool)
+    if safeguards.finger_thickness:
+        clear = fingers_clear(contour, hand, poses, lam, point, clearance=safeguards.clearance)
+    epsilon = np.full(len(poses), np.nan)
+    if safeguards.grades_quality:
+        epsilon = grasp_epsilon(model, point, t, touching, friction=safeguards.friction)
+    return _assemble(hand, poses, touching, lam, t, point, curv, start_inside, d_min, clear, epsilon, safeguards)
 
 
 def screen_grid(
@@ -385,63 +493,203 @@ def screen_grid(
     """Evaluate every pose of a grid fast, to within the EFD polygon's accuracy.
 
     Contacts stay on the sampled polygon (``samples`` points) and curvature is
-    interpolated from a table, so costs differ from :func:`evaluate_poses` by
-    about 1e-4 relative; :func:`synthesize` re-evaluates the best candidates
+    interpolated from tables (``tol.CURVATURE_TABLE`` samples), so costs differ
+    from :func:`evaluate_poses` by about 1e-4 relative (up to ~1 where a contact
+    grazes the contour); :func:`synthesize` re-evaluates the best candidates
     exactly. The inner loop is the compiled :func:`contourgrasp._kernels.grid_first_touch`.
     """
     xs, ys, yaws = grid.axes(model.locus)
     contour_t, contour = efd_model.sample(model, samples)
     seg = hand.segments()
     n_f = len(hand.fingers)
-    first = np.zeros(len(seg.finger), bool)
-    first[np.searchsorted(seg.finger, np.arange(n_f))] = True
-    table_t = np.linspace(0.0, model.T, tol.CURVATURE_TABLE, endpoint=False)
-    lam, t, point, curv, start_inside = grid_first_touch(
-        contour, contour_t, model.T, efd_model.curvature(model, table_t, curvature), xs, ys, yaws,
-        seg.start, seg.end - seg.start, seg.finger, seg.lam0, first, n_f, tol.PARALLEL,
+    first = _first_chords(seg, n_f)
+    lam, t, point, start_inside = grid_first_touch(
+        contour, contour_t, model.T, xs, ys, yaws, seg.start, seg.end - seg.start, seg.finger, seg.lam0, first, n_f,
+        tol.PARALLEL,
     )
+    # The paper's curvature jumps where the contour turns from convex to concave; its magnitude and
+    # the turning direction r' x r'' do not, so they are tabulated and interpolated apart.
+    table_t = np.linspace(0.0, model.T, tol.CURVATURE_TABLE, endpoint=False)
+    d1, d2 = efd_model.evaluate(model, table_t, 1), efd_model.evaluate(model, table_t, 2)
+    turn = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
+    magnitude = np.abs(efd_model.curvature(model, table_t, curvature))
+    curv = interpolate_curvature(magnitude, turn, t, model.T)
     touching = np.isfinite(lam)
     poses = grid.poses(model.locus)
-    return _assemble(hand, poses, touching, np.where(touching, lam, np.nan), t, point, curv, start_inside, d_min=grid.d_min)
+    n = len(poses)
+    return _assemble(hand, poses, touching, np.where(touching, lam, np.nan), t, point, curv, start_inside,
+                     grid.d_min, np.ones(n, bool), np.full(n, np.nan), Safeguards())
 
 
-def _refine(model: EFD, hand: Hand, poses, t, lam, point, touching, t_step, iterations: int = 4):
-    """Newton on r(t) - p(lam) = 0 from the polygon's contacts; keeps the polygon's answer where it fails."""
+def refine_poses(
+    model: EFD,
+    hand: Hand,
+    poses,
+    *,
+    step=(0.05, math.radians(2.0)),
+    d_max=None,
+    halvings: int = tol.REFINE_HALVINGS,
+    rounds: int = tol.REFINE_ROUNDS,
+    **evaluation,
+) -> PoseEvaluation:
+    """Improve poses continuously: a bounded compass search on the exact cost of :func:`evaluate_poses`.
+
+    The grid of the outer problem (eq 3.39-3.40) only visits multiples of its steps; the optimum
+    of eq 3.34 lies between them. From each pose the search tries +-s along x, y and yaw (every
+    pose and direction in one call of :func:`evaluate_poses`), moves to the cheapest feasible trial
+    cheaper than where it stands and doubles s (up to half a grid step, where it starts), or halves
+    s where there is none. A pose stops when s falls below half a grid step / 2**``halvings``, and
+    every pose after ``rounds`` rounds. The cost is piecewise smooth (a finger's contact jumps where
+    it grazes the contour), which a compass search, unlike a gradient method, takes in its stride.
+
+    A pose stays within one grid step of its start and, with ``d_max``, within D_max of the
+    locus. A feasible pose stays feasible and its cost never rises; an infeasible one moves to a
+    feasible trial when it finds one.
+
+    Parameters
+    ----------
+    model : EFD
+    hand : Hand
+    poses : (p, 3) float
+        Start poses (x, y, yaw), e.g. the grid's best.
+    step : (2,) float
+        The grid's (xy, yaw) steps, m and rad.
+    d_max : float or (2,) float, optional
+        D_max,x and D_max,y of eq 3.39-3.40, m; None: no bound but the step box.
+    halvings : int
+        Halvings of s before a pose stops (resolution: step / 2**(halvings + 1)).
+    rounds : int
+        Calls of :func:`evaluate_poses` at most, after the one for the start poses.
+    **evaluation
+        Passed to every :func:`evaluate_poses` call (``curvature``, ``d_min``, ``samples``, its
+        constraints...): the refined poses satisfy what the grid's did.
+
+    Returns
+    -------
+    PoseEvaluation
+        Of the refined poses, in the order given.
+    """
+    poses = np.atleast_2d(np.asarray(poses, dtype=float))
+    steps = np.asarray(step, dtype=float)
+    if steps.shape != (2,) or not np.all(np.isfinite(steps) & (steps > 0)):
+        raise InputError(f"step must be two positive numbers (xy, yaw), got {step!r}")
+    for name, value in (("halvings", halvings), ("rounds", rounds)):
+        if not isinstance(value, (int, np.integer)) or value < 0:
+            raise InputError(f"{name} must be a non-negative integer, got {value!r}")
+    scale = steps[[0, 0, 1]]
+    lower, upper = poses - scale, poses + scale
+    if d_max is not None:
+        box = np.broadcast_to(np.asarray(d_max, dtype=float), (2,))
+        if not np.all(np.isfinite(box) & (box >= 0)):
+            raise InputError(f"d_max must be non-negative, got {d_max!r}")
+        lower[:, :2] = np.maximum(lower[:, :2], model.locus - box)
+        upper[:, :2] = np.minimum(upper[:, :2], model.locus + box)
+    directions = np.vstack([np.eye(3), -np.eye(3)]) * scale
+    current = evaluate_poses(model, hand, poses, **evaluation)
+    s = np.full(len(poses), 0.5)
+    for _ in range(rounds):
+        active = np.flatnonzero(s >= 0.5**(halvings + 1))
+        if active.size == 0:
+            break
+        trials = np.clip(current.poses[active, None] + s[active, None, None] * directions,
+                         lower[active, None], upper[active, None])
+        tried = evaluate_poses(model, hand, trials.reshape(-1, 3), **evaluation)
+        cost = np.where(tried.feasible, tried.cost, np.inf).reshape(len(active), len(directions))
+        pick = np.argmin(cost, axis=1)
+        best = cost[np.arange(len(active)), pick]
+        moves = np.isfinite(best) & (~current.feasible[active] | (best < current.cost[active]))
+        current = _replace_rows(current, active[moves], tried, (np.arange(len(active)) * len(directions) + pick)[moves])
+        s[active] = np.where(moves, np.minimum(2 * s[active], 0.5), s[active] / 2)
+    np.mod(current.poses[:, 2], 2 * math.pi, out=current.poses[:, 2])  # the box may reach below yaw 0
+    return current
+
+
+def _replace_rows(evaluation: PoseEvaluation, rows, source: PoseEvaluation, source_rows) -> PoseEvaluation:
+    """``evaluation`` with its ``rows`` replaced by ``source_rows`` of ``source``."""
+    def replaced(name):
+        values = getattr(evaluation, name).copy()
+        values[rows] = getattr(source, name)[source_rows]
+        return values
+
+    return PoseEvaluation(**{f.name: replaced(f.name) for f in fields(PoseEvaluation)})
+
+
+def _concatenate(*evaluations: PoseEvaluation) -> PoseEvaluation:
+    """The poses of several evaluations, in order, as one."""
+    return PoseEvaluation(**{f.name: np.concatenate([getattr(e, f.name) for e in evaluations])
+                             for f in fields(PoseEvaluation)})
+
+
+def _first_chords(segments: HandSegments, n_fingers: int) -> np.ndarray:
+    """(s,) bool: the chord is its finger's first (its half-line decides whether the finger starts inside)."""
+    first = np.zeros(len(segments.finger), bool)
+    first[np.searchsorted(segments.finger, np.arange(n_fingers))] = True
+    return first
+
+
+def _newton(model: EFD, hand: Hand, poses, t, lam, point, touching, t_step, iterations: int = 4):
+    """Newton on r(t) - p(lam) = 0 from the polygon's contacts; keeps the polygon's answer where it fails.
+
+    Every touching (pose, finger) pair iterates at once: the curve is evaluated for all of them
+    together, which is most of the work. From the polygon's contacts (within ~1e-5 m) Newton
+    converges in two or three steps; it stops once no step exceeds 1e-12 m.
+    """
     t, lam, point = t.copy(), lam.copy(), point.copy()
-    for f, finger in enumerate(hand.fingers):
-        rows = np.flatnonzero(touching[:, f])
-        if rows.size == 0:
-            continue
-        R = rotation(poses[rows, 2])
-        xy = poses[rows, :2]
-        t_f, lam_f = t[rows, f], lam[rows, f]
-        for _ in range(iterations):
-            r, dr = efd_model.evaluate(model, t_f), efd_model.evaluate(model, t_f, 1)
-            p = xy + np.einsum("pij,pj->pi", R, finger.points(lam_f))
-            dp = np.einsum("pij,pj->pi", R, finger.tangent(lam_f))
-            F = r - p
-            det = -dr[:, 0] * dp[:, 1] + dp[:, 0] * dr[:, 1]
-            det = np.where(np.abs(det) > 1e-12, det, np.inf)
-            t_f = t_f + (F[:, 0] * dp[:, 1] - F[:, 1] * dp[:, 0]) / det
-            lam_f = lam_f + (dr[:, 1] * F[:, 0] - dr[:, 0] * F[:, 1]) / det
-        residual = np.linalg.norm(
-            efd_model.evaluate(model, t_f) - xy - np.einsum("pij,pj->pi", R, finger.points(lam_f)), axis=1
-        )
-        ok = (residual < 1e-9) & (lam_f >= 0) & (lam_f <= finger.travel) & (np.abs(t_f - t[rows, f]) < 2 * t_step)
-        rows = rows[ok]
-        t[rows, f] = t_f[ok] % model.T
-        lam[rows, f] = lam_f[ok]
-        point[rows, f] = efd_model.evaluate(model, t_f[ok])
+    rows, fingers = np.nonzero(touching)
+    R = rotation(poses[rows, 2])
+    xy = poses[rows, :2]
+    t_i, lam_i = t[rows, fingers], lam[rows, fingers]
+    for _ in range(iterations):
+        local, direction = _trajectory(hand, fingers, lam_i)
+        r, dr = efd_model.evaluate(model, t_i), efd_model.evaluate(model, t_i, 1)
+        F = r - xy - np.einsum("pij,pj->pi", R, local)
+        dp = np.einsum("pij,pj->pi", R, direction)
+        det = -dr[:, 0] * dp[:, 1] + dp[:, 0] * dr[:, 1]
+        det = np.where(np.abs(det) > 1e-12, det, np.inf)
+        step_t = (F[:, 0] * dp[:, 1] - F[:, 1] * dp[:, 0]) / det
+        step_lam = (dr[:, 1] * F[:, 0] - dr[:, 0] * F[:, 1]) / det
+        t_i, lam_i = t_i + step_t, lam_i + step_lam
+        if not (np.abs(step_t) > 1e-12).any() and not (np.abs(step_lam) > 1e-12).any():
+            break
+    local, _ = _trajectory(hand, fingers, lam_i)
+    r = efd_model.evaluate(model, t_i)
+    residual = np.linalg.norm(r - xy - np.einsum("pij,pj->pi", R, local), axis=1)
+    travel = np.array([f.travel for f in hand.fingers])[fingers]
+    ok = (residual < 1e-9) & (lam_i >= 0) & (lam_i <= travel) & (np.abs(t_i - t[rows, fingers]) < 2 * t_step)
+    rows, fingers = rows[ok], fingers[ok]
+    t[rows, fingers] = t_i[ok] % model.T
+    lam[rows, fingers] = lam_i[ok]
+    point[rows, fingers] = r[ok]
     return t, lam, point
 
 
-def _assemble(hand: Hand, poses, touching, lam, t, point, curv, start_inside, d_min) -> PoseEvaluation:
-    """Constraints 3.39-3.41 and the cost of eq 3.34 from the inner problem's solutions."""
+def _trajectory(hand: Hand, fingers, lam) -> tuple[np.ndarray, np.ndarray]:
+    """Hand-frame points and unit tangents (both (n, 2)) of finger ``fingers`` (n,) int after travelling ``lam`` (n,).
+
+    Rays in one expression (this runs in every Newton step), arcs finger by finger.
+    """
+    rays = np.array([f.trajectory.closing_direction if isinstance(f.trajectory, Ray) else (np.nan, np.nan)
+                     for f in hand.fingers])
+    tangents = rays[fingers]
+    points = hand.starts[fingers] + lam[:, None] * tangents
+    for f in np.unique(fingers[np.isnan(tangents[:, 0])]):
+        rows = fingers == f
+        points[rows], tangents[rows] = hand.fingers[f].points(lam[rows]), hand.fingers[f].tangent(lam[rows])
+    return points, tangents
+
+
+def _assemble(hand: Hand, poses, touching, lam, t, point, curv, start_inside, d_min, clear, epsilon,
+              safeguards: Safeguards) -> PoseEvaluation:
+    """Constraints 3.39-3.41 and the cost of eq 3.34 (plus the safeguards') from the inner problem's solutions."""
     (distance, start_distance, outside, reaches, far_enough, cost_curvature, cost_ratio, cost_miss) = score_poses(
         poses, touching, point, curv, start_inside, hand.starts, hand.virtual_starts,
         np.array([f.alpha for f in hand.fingers], dtype=float), np.array([f.beta for f in hand.fingers], dtype=float),
         np.array([f.required for f in hand.fingers]), hand.min_touching, float(hand.miss_penalty), float(d_min),
     )
+    feasible = outside & reaches & far_enough & clear
+    if safeguards.require_closure:
+        feasible &= epsilon > 0
+    cost_quality = -safeguards.quality_gain * np.nan_to_num(epsilon) if safeguards.quality_gain else np.zeros(len(poses))
     return PoseEvaluation(
         poses=poses,
         touching=touching,
@@ -454,25 +702,103 @@ def _assemble(hand: Hand, poses, touching, lam, t, point, curv, start_inside, d_
         start_inside=start_inside,
         starts_outside=outside,
         reaches=reaches,
-        feasible=outside & reaches & far_enough,
+        clear=clear,
+        epsilon=epsilon,
+        feasible=feasible,
         cost_curvature=cost_curvature,
         cost_ratio=cost_ratio,
         cost_miss=cost_miss,
-        cost=cost_curvature + cost_ratio + cost_miss,
+        cost_quality=cost_quality,
+        cost=cost_curvature + cost_ratio + cost_miss + cost_quality,
     )
+
+
+def fingers_clear(contour, hand: Hand, poses, lam, grasp_point, *, clearance: float = 0.0,
+                  samples: int = 9) -> np.ndarray:
+    """Finger-thickness check of :class:`Safeguards` for each pose.
+
+    Parameters
+    ----------
+    contour : (m, 2) float
+        The object's polygon (e.g. the EFD curve sampled).
+    hand : Hand
+        Finger radii from ``Finger.radius``.
+    poses : (p, 3) float
+    lam : (p, f) float
+        Travel to the grasp point; NaN for a finger that misses (it sweeps its whole travel).
+    grasp_point : (p, f, 2) float
+    clearance : float
+        Extra free distance required around every open fingertip, m.
+    samples : int
+        Points of each swept path (its chords bound arcs to a fraction of a mm).
+
+    Returns
+    -------
+    (p,) bool
+        Every fingertip starts ``radius + clearance`` clear of the contour and
+        its swept disc first meets the contour within ``2 radius`` of its grasp point.
+    """
+    poses = np.atleast_2d(np.asarray(poses, dtype=float))
+    p = len(poses)
+    edges = np.roll(contour, -1, axis=0) - contour
+    rotations = rotation(poses[:, 2])
+    u = np.linspace(0.0, 1.0, samples)
+    ok = np.ones(p, bool)
+    for f, finger in enumerate(hand.fingers):
+        reach = np.where(np.isfinite(lam[:, f]), lam[:, f], finger.travel)
+        path = finger.points(np.outer(reach, u).ravel()).reshape(p, samples, 2)
+        path = np.einsum("pij,pkj->pki", rotations, path) + poses[:, None, :2]
+        ok &= _distance_to_segments(path[:, :1], contour[None], edges[None]).min(axis=2)[:, 0] >= (
+            finger.radius + clearance)
+        if finger.radius == 0:
+            continue
+        swept = _distance_to_segments(contour[None], path[:, :-1], np.diff(path, axis=1)).min(axis=2) < finger.radius
+        with np.errstate(invalid="ignore"):
+            elsewhere = ~(np.linalg.norm(contour[None] - grasp_point[:, f, None], axis=2) <= 2 * finger.radius)
+        ok &= ~(swept & elsewhere).any(axis=1)
+    return ok
+
+
+def _distance_to_segments(points, starts, vectors) -> np.ndarray:
+    """(p, n, k): distance of points (p | 1, n, 2) to segments starts + [0, 1] vectors (p | 1, k, 2)."""
+    w = points[:, :, None, :] - starts[:, None, :, :]
+    length2 = np.maximum(np.sum(vectors * vectors, axis=-1), np.finfo(float).tiny)[:, None, :]
+    s = np.clip(np.einsum("pnki,pki->pnk", w, np.broadcast_to(vectors, (len(w), *vectors.shape[1:]))) / length2,
+                0.0, 1.0)
+    return np.linalg.norm(w - s[..., None] * vectors[:, None, :, :], axis=-1)
+
+
+def grasp_epsilon(model: EFD, grasp_point, t, touching, *, friction: float = 0.5) -> np.ndarray:
+    """(p,) float: Ferrari-Canny L1 epsilon of each pose's grasp points on the EFD contour.
+
+    Wrenches are taken about the EFD locus (A0, C0) with torques divided by the
+    contour's largest radius about it, so that poses of one plan compare
+    (:func:`contourgrasp.quality.epsilon_many`); normals are the curve's inward normals.
+    """
+    normals = quality.contour_normals(model, np.where(touching, t, 0.0))
+    valid = touching & np.isfinite(normals).all(axis=-1)
+    _, polygon = efd_model.sample(model)
+    rho = float(np.linalg.norm(polygon - model.locus, axis=1).max())
+    return quality.epsilon_many(grasp_point, normals, valid, mu=friction, centre=model.locus, rho=rho)
 
 
 def synthesize(
     contour_xy,
     hand: Hand,
     *,
-    harmonics: int = 4,
+    harmonics: int | Literal["adaptive"] = 4,
     curvature: CurvatureMode = "paper",
     xy_step: float = 0.05,
     yaw_step: float = math.radians(2.0),
     d_max=(0.15, 0.15),
     d_min: float = 0.015,
     top_k: int = 10,
+    refine: bool = False,
+    finger_thickness: bool = False,
+    clearance: float = 0.0,
+    friction: float = 0.5,
+    require_closure: bool = False,
+    quality_gain: float = 0.0,
 ) -> GraspPlan:
     """Plan a grasp on a contour: fit the EFD model, search the pose grid, return the best pose.
 
@@ -482,8 +808,9 @@ def synthesize(
         Closed object contour in the image plane, meters, either orientation.
     hand : Hand
         (:func:`contourgrasp.synthesize` also takes a preset name or a TOML path.)
-    harmonics : int
-        EFD harmonics (thesis: 4).
+    harmonics : int or "adaptive"
+        EFD harmonics (thesis: 4); ``"adaptive"`` chooses them per object
+        (:func:`contourgrasp.efd.choose_harmonics` with its defaults).
     curvature : {"paper", "geometric"}
         Curvature flavour of the cost, see :mod:`contourgrasp.efd`.
     xy_step, yaw_step : float
@@ -494,6 +821,13 @@ def synthesize(
         D_min, m (Table 4.2: 0.015).
     top_k : int
         Number of distinct ranked poses to keep in ``alternatives``.
+    refine : bool
+        After the grid, refine its best ``tol.REFINE_STARTS`` distinct poses continuously
+        (:func:`refine_poses`, under the same constraints) and keep the better; ``refinement``
+        reports the gain.
+    finger_thickness, clearance, friction, require_closure, quality_gain
+        The :class:`Safeguards` (all off: the thesis's problem). ``friction`` is
+        also the mu of the plan's reported ``quality``.
 
     Returns
     -------
@@ -520,23 +854,42 @@ def synthesize(
     if not isinstance(hand, Hand):
         raise InputError(f"hand must be a Hand, got {type(hand).__name__} (contourgrasp.synthesize loads names)")
     grid = SearchGrid(xy_step=xy_step, yaw_step=yaw_step, d_max=d_max, d_min=d_min)
+    safeguards = Safeguards(finger_thickness=bool(finger_thickness), clearance=clearance, friction=friction,
+                            require_closure=bool(require_closure), quality_gain=quality_gain)
 
     clock = time.perf_counter()
     contour = efd_model.clean_polygon(contour_xy)
+    if harmonics == "adaptive":
+        harmonics = efd_model.choose_harmonics(contour, validate=False)
     model = efd_model.fit(contour, harmonics, validate=False)
     fitted = time.perf_counter()
     screen = screen_grid(model, hand, grid, curvature=curvature)
     searched = time.perf_counter()
     if not screen.feasible.any():
         raise NoFeasibleGrasp(_diagnose(screen, hand, grid))
-    result = _reevaluate_best(model, hand, screen, max(tol.REFINE_CANDIDATES, 4 * top_k), curvature, grid.d_min)
+    result = _reevaluate_best(model, hand, screen, max(tol.REFINE_CANDIDATES, 4 * top_k), curvature, grid.d_min,
+                              safeguards)
     ranked = _distinct_best(result, grid, top_k)
+    exact = time.perf_counter()
+    refinement, refined_at = None, exact
+    if refine:
+        grid_best = ranked[0]
+        refined = refine_poses(model, hand, result.poses[ranked[:tol.REFINE_STARTS]],
+                               step=(grid.xy_step, grid.yaw_step), d_max=grid.d_max,
+                               curvature=curvature, d_min=grid.d_min, safeguards=safeguards)
+        result = _concatenate(refined, result)
+        ranked = _distinct_best(result, grid, top_k)
+        refinement = Refinement(tuple(map(float, result.poses[len(refined.poses) + grid_best])),
+                                float(result.cost[len(refined.poses) + grid_best]), float(result.cost[ranked[0]]))
+        refined_at = time.perf_counter()
     best = ranked[0]
     fingers = _contacts(model, hand, result, best, curvature)
+    grasp_quality = _quality(model, result, best, friction)
     timing = {
         "efd": 1e3 * (fitted - clock),
         "search": 1e3 * (searched - fitted),
-        "refine": 1e3 * (time.perf_counter() - searched),
+        "exact": 1e3 * (exact - searched),
+        "refine": 1e3 * (refined_at - exact),
         "total": 1e3 * (time.perf_counter() - clock),
     }
     return GraspPlan(
@@ -552,19 +905,44 @@ def synthesize(
         grid_size=len(screen.poses),
         feasible_poses=int(screen.feasible.sum()),
         timing_ms=timing,
+        refinement=refinement,
+        safeguards=safeguards,
+        quality=grasp_quality,
     )
 
 
-def _reevaluate_best(model, hand, screen: PoseEvaluation, n: int, curvature, d_min) -> PoseEvaluation:
-    """Exact evaluation of the n cheapest screened poses (all feasible ones if none of those stays feasible)."""
+def _reevaluate_best(model, hand, screen: PoseEvaluation, n: int, curvature, d_min,
+                     safeguards: Safeguards) -> PoseEvaluation:
+    """Exact evaluation of the n cheapest screened poses, then 4n, 16n, ... until one is feasible."""
     feasible = np.flatnonzero(screen.feasible)
     order = feasible[np.argsort(screen.cost[feasible], kind="stable")]
-    for candidates in (order[:n], order):
-        result = evaluate_poses(model, hand, screen.poses[candidates], curvature=curvature, d_min=d_min)
+    while True:
+        result = evaluate_poses(model, hand, screen.poses[order[:n]], curvature=curvature, d_min=d_min,
+                                safeguards=safeguards)
         if result.feasible.any():
             return result
-    raise NoFeasibleGrasp("every pose that reaches the object fails a constraint once its contacts are "
-                          "computed on the EFD curve itself rather than its polygon")
+        if n >= len(order):
+            raise NoFeasibleGrasp(_diagnose_exact(result, safeguards))
+        n *= 4
+
+
+def _diagnose_exact(result: PoseEvaluation, safeguards: Safeguards) -> str:
+    """Why no screened pose survives exact evaluation."""
+    n = len(result.poses)
+    if safeguards.finger_thickness and not result.clear.any():
+        return (f"every one of the {n} poses that reach the object has a finger starting closer than its radius + "
+                f"{safeguards.clearance} m to the object or striking it before its grasp point")
+    if safeguards.require_closure and not (result.epsilon > 0).any():
+        return f"none of the {n} poses that reach the object puts its grasp points in force closure"
+    return ("every pose that reaches the object fails a constraint once its contacts are "
+            "computed on the EFD curve itself rather than its polygon")
+
+
+def _quality(model: EFD, result: PoseEvaluation, i: int, friction: float) -> quality.GraspQuality:
+    """Force closure and L1 epsilon of pose i's grasp points (as :func:`grasp_epsilon` grades them)."""
+    eps = float(grasp_epsilon(model, result.grasp_point[i:i + 1], result.t[i:i + 1], result.touching[i:i + 1],
+                              friction=friction)[0])
+    return quality.GraspQuality(force_closure=eps > 0, epsilon=eps, metric="L1", mu=float(friction))
 
 
 def _cost(result: PoseEvaluation, i: int) -> Cost:
@@ -573,6 +951,7 @@ def _cost(result: PoseEvaluation, i: int) -> Cost:
         curvature=float(result.cost_curvature[i]),
         ratio=float(result.cost_ratio[i]),
         miss=float(result.cost_miss[i]),
+        quality=float(result.cost_quality[i]),
     )
 
 
@@ -615,14 +994,16 @@ def _contacts(model: EFD, hand: Hand, result: PoseEvaluation, i: int, mode: Curv
     pose = result.poses[i]
     starts = to_image(hand.starts, pose)
     virtual = to_image(hand.virtual_starts, pose)
-    contacts = []
+    found = []
     for f, finger in enumerate(hand.fingers):
-        missed = not result.touching[i, f]
-        if missed:
-            t, lam, point, gap = closest_approach(model, finger, pose)
+        if result.touching[i, f]:
+            found.append((result.t[i, f], result.lam[i, f], result.grasp_point[i, f], 0.0))
         else:
-            t, lam, point, gap = result.t[i, f], result.lam[i, f], result.grasp_point[i, f], 0.0
-        kappa = float(efd_model.curvature(model, [t], mode)[0])
+            found.append(closest_approach(model, finger, pose))
+    curvatures = efd_model.curvature(model, [t for t, *_ in found], mode)
+    contacts = []
+    for f, (finger, (t, lam, point, gap), kappa) in enumerate(zip(hand.fingers, found, curvatures.tolist())):
+        missed = not result.touching[i, f]
         contacts.append(FingerContact(
             name=finger.name,
             grasp_point=np.asarray(point, dtype=float),
@@ -663,18 +1044,8 @@ def closest_approach(model: EFD, finger, pose, samples: int = tol.EFD_SAMPLES, c
     edges = np.roll(contour, -1, axis=0) - contour
     steps = np.diff(path, axis=0)
     # path vertices against contour edges, then contour vertices against path chords
-    s1, gap1 = _point_segment(path, contour, edges)
-    s2, gap2 = _point_segment(contour, path[:-1], steps)
-    if gap1.min() <= gap2.min():
-        i, k = np.unravel_index(np.argmin(gap1), gap1.shape)
-        point = contour[k] + s1[i, k] * edges[k]
-        return float(t[k] + s1[i, k] * model.T / samples), float(lam[i]), point, float(gap1[i, k])
-    k, j = np.unravel_index(np.argmin(gap2), gap2.shape)
-    return float(t[k]), float(lam[j] + s2[k, j] * (lam[j + 1] - lam[j])), contour[k], float(gap2[k, j])
-
-
-def _point_segment(points, starts, vectors):
-    """Fraction along each segment of the nearest point, and the distance: both (n_points, n_segments)."""
-    w = points[:, None, :] - starts[None, :, :]
-    s = np.clip(np.einsum("nsi,si->ns", w, vectors) / np.sum(vectors * vectors, axis=1), 0.0, 1.0)
-    return s, np.linalg.norm(w - s[..., None] * vectors[None], axis=2)
+    i, k, s1, gap1 = nearest_point_segment(path, contour, edges)
+    k2, j, s2, gap2 = nearest_point_segment(contour, path[:-1], steps)
+    if gap1 <= gap2:
+        return float(t[k] + s1 * model.T / samples), float(lam[i]), contour[k] + s1 * edges[k], gap1
+    return float(t[k2]), float(lam[j] + s2 * (lam[j + 1] - lam[j])), contour[k2], gap2

@@ -32,14 +32,22 @@ PARALLEL = 1e-15
 #: Length of a closing direction below which it has no direction.
 MIN_DIRECTION = 1e-9
 
-#: Samples of the curvature table used while screening the grid.
-CURVATURE_TABLE = 4096
+#: Samples of the curvature tables (magnitude, turning sign) used while screening the grid.
+#: Building them is a fixed cost of every plan; with the sign interpolated apart, 1024 keeps the
+#: screened costs of every example within 1 of the exact ones (4096 in one table: within 38).
+CURVATURE_TABLE = 1024
 
 #: Screened poses re-evaluated exactly (at least; 4 x top_k if more).
 REFINE_CANDIDATES = 32
 
-#: Poses evaluated at once; bounds the memory of the (poses, segments, edges) arrays.
-POSE_CHUNK = 256
+#: Distinct best grid poses the continuous refinement starts from (``synthesize(refine=True)``).
+REFINE_STARTS = 4
+
+#: Halvings of the refinement's step, from half a grid step: 0.05 m / 2**9 = 0.1 mm, 2 deg / 2**9.
+REFINE_HALVINGS = 8
+
+#: Rounds (calls of evaluate_poses, all starts at once) of the refinement at most.
+REFINE_ROUNDS = 40
 
 #: Wrench-space zero (wrenches scaled to unit normal force, torque / rho): a Ferrari-Canny
 #: epsilon at or below this is no force closure, and a wrench this far outside a plane

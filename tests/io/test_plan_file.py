@@ -10,9 +10,13 @@ from contourgrasp.io.plan_file import atomic_outputs, plan_to_dict, write_json
 def test_plan_json_schema():
     plan = cg.synthesize(cg.example_contour("can"), "three-finger", yaw_step=math.radians(10), top_k=3)
     data = json.loads(json.dumps(plan_to_dict(plan)))
-    assert set(data) >= {"pose", "cost", "curvature_mode", "fingers", "efd", "alternatives", "timing_ms", "grid"}
+    assert set(data) >= {"pose", "cost", "curvature_mode", "fingers", "efd", "alternatives", "timing_ms", "grid",
+                         "safeguards", "quality"}
     assert set(data["pose"]) == {"x", "y", "yaw"}
-    assert set(data["cost"]) == {"total", "curvature", "ratio", "miss"}
+    assert set(data["cost"]) == {"total", "curvature", "ratio", "miss", "quality"}
+    assert data["quality"]["force_closure"] is True and data["quality"]["epsilon"] > 0  # three fingers around a can
+    assert data["safeguards"] == {"finger_thickness": False, "clearance": 0.0, "friction": 0.5,
+                                  "require_closure": False, "quality_gain": 0.0}
     finger_keys = {"name", "grasp_point", "t", "lambda", "curvature", "concave", "distance", "start",
                    "virtual_start", "missed", "gap"}
     assert all(set(f) == finger_keys for f in data["fingers"])

@@ -11,9 +11,13 @@ import contourgrasp
 from contourgrasp.cli import main
 from contourgrasp.hand import to_image
 from contourgrasp.pipeline import plan_grasp
+from contourgrasp.io.planner_file import load_planner
 from contourgrasp.sim import NO_PLAN, Camera, ObjectSpec, Part, Workspace, build_scene, render
-from contourgrasp.sim.bench import Bench, console_progress, run_bench, write_outputs
-from contourgrasp.sim.planners import camera_intrinsics, centroid_pose, perceive, random_feasible_pose, search_settings
+from contourgrasp.sim.bench import (Bench, BenchTrial, ablation_table, console_progress, run_bench, wilson_interval,
+                                    write_outputs)
+from contourgrasp.sim.planners import (ABLATION_STEPS, ablation_planners, camera_intrinsics, centroid_pose, perceive,
+                                       random_feasible_pose, search_settings)
+from contourgrasp.sim.trial import PUSHED, TrialRecord
 from contourgrasp.synthesis import evaluate_poses
 
 HAND = contourgrasp.load_hand("five-finger-linear")
@@ -146,3 +150,51 @@ def test_progress_counts_every_trial():
         for label in "abc":
             update(label)
     assert "3/3" in stream.getvalue()
+
+
+@pytest.mark.parametrize("wins, n, low, high", [(0, 10, 0.0, 0.2775), (10, 10, 0.7225, 1.0), (5, 10, 0.2366, 0.7634),
+                                                (18, 20, 0.6990, 0.9721)])
+def test_wilson_interval_matches_its_closed_form(wins, n, low, high):
+    assert wilson_interval(wins, n) == pytest.approx((low, high), abs=1e-4)
+
+
+def test_ablation_walks_from_paper_to_default_one_group_at_a_time():
+    steps = ablation_planners()
+    assert steps[0].name == "paper" and dict(steps[-1].options) == load_planner("default").plan_options
+    groups = dict(ABLATION_STEPS)
+    for before, after in zip(steps, steps[1:]):
+        changed = {k for k in dict(before.options) | dict(after.options)
+                   if dict(before.options).get(k) != dict(after.options).get(k)}
+        step = after.name.rsplit("+", 1)[1]
+        assert changed and (step == "other" or changed <= set(groups[step]))
+
+
+def test_ablation_table_counts_rates_and_causes():
+    steps = [p.name for p in ablation_planners()]
+    ran = (*steps[:-1], "default")
+    bench = Bench(objects=(contourgrasp.sim.objects.object_spec("can"),), planners=ran, trials=2)
+    record = dict(object="can", seed=0, fingers_in_contact=(), first_contact=(), push=0.0, lift=0.0, hold_drift=0.0,
+                  pose=None, approach_depth=None, plan_error=None, sim_time=1.0, plan_time=0.1, wall_time=1.0)
+    results = [BenchTrial(p, t, TrialRecord(success=t == 0, cause=None if t == 0 else PUSHED, **record))
+               for p in ran for t in range(2)]
+    table = ablation_table(bench, results)
+    assert len(table) == 2 + len(ran)
+    assert table[2].startswith("| paper | 50 % (9–91) |")
+    assert table[-1].startswith(f"| {steps[-1]} = `default` | 50 % (9–91) |") and table[-1].count("| 1 |") == 1
+
+
+def test_a_planner_file_runs_on_the_bench(tmp_path, capsys):
+    planner = tmp_path / "coarse.toml"
+    planner.write_text('name = "coarse"\nxy_step = 0.05\nyaw_step = 0.1\n')
+    out = tmp_path / "out"
+    code, err = run_cli(["bench", "--objects", "case", "--trials", "1", "--planners", str(planner), "--out", out],
+                        capsys)
+    assert code == 0, err
+    assert f"- `{planner}`: `plan_grasp` with xy_step=0.05, yaw_step=5.72958°" in (out / "table.md").read_text()
+
+
+def test_mesh_names_are_distinct_and_never_a_thesis_objects():
+    from contourgrasp.cli import _mesh_names
+
+    paths = ["a/YcbMustardBottle/model.obj", "b/YcbGelatinBox/model.obj", "robosuite/bottle.obj", "x/mug.obj"]
+    assert _mesh_names(paths) == ["YcbMustardBottle", "YcbGelatinBox", "robosuite-bottle", "mug"]

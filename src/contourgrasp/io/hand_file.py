@@ -19,6 +19,8 @@ Schema (all lengths in meters, angles in radians)::
     alpha = 25.0                     # curvature gain, optional, default 1
     beta = 10000.0                   # ratio gain, optional, default 0
     required = true                  # optional, default false
+    radius = 0.011                   # optional, >= 0, default 0: half the finger's
+                                     # width (finger-thickness check of the planner)
 
 Unknown keys, wrong types and impossible values are refused with
 :class:`~contourgrasp.errors.HandFileError` naming the file and the field.
@@ -27,15 +29,13 @@ Unknown keys, wrong types and impossible values are refused with
 from __future__ import annotations
 
 import json
-import tomllib
-from importlib import resources
-from pathlib import Path
 from typing import Annotated
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from ..errors import HandFileError
 from ..hand import Arc, Finger, Hand, Ray
+from . import _toml_files
 
 _PRESET_DIR = "data/hands"
 
@@ -67,6 +67,7 @@ class _FingerSchema(_Strict):
     alpha: FiniteFloat = 1.0
     beta: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.0
     required: bool = False
+    radius: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.0
 
     @model_validator(mode="after")
     def _one_trajectory(self):
@@ -96,8 +97,7 @@ class _HandSchema(_Strict):
 
 def preset_names() -> list[str]:
     """Names of the built-in hands, sorted."""
-    folder = resources.files("contourgrasp").joinpath(_PRESET_DIR)
-    return sorted(p.name.removesuffix(".toml") for p in folder.iterdir() if p.name.endswith(".toml"))
+    return _toml_files.preset_names(_PRESET_DIR)
 
 
 def load_hand(spec) -> Hand:
@@ -110,26 +110,13 @@ def load_hand(spec) -> Hand:
     """
     if isinstance(spec, Hand):
         return spec
-    spec = str(spec)
-    if spec in preset_names():
-        resource = resources.files("contourgrasp").joinpath(f"{_PRESET_DIR}/{spec}.toml")
-        return parse_hand(resource.read_text(encoding="utf-8"), source=f"preset {spec}")
-    path = Path(spec)
-    if not path.suffix and not path.exists():
-        raise HandFileError(f"unknown hand {spec!r}: not a preset ({', '.join(preset_names())}) nor a file")
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as err:
-        raise HandFileError(f"{path}: cannot read hand file ({err.strerror or err})") from None
-    return parse_hand(text, source=str(path))
+    text, source = _toml_files.read_spec(str(spec), _PRESET_DIR, kind="hand", error=HandFileError)
+    return parse_hand(text, source=source)
 
 
 def parse_hand(text: str, *, source: str = "<string>") -> Hand:
     """Parse and validate the TOML text of a hand description; ``source`` names it in errors."""
-    try:
-        raw = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as err:
-        raise HandFileError(f"{source}: not valid TOML ({err})") from None
+    raw = _toml_files.parse_toml(text, source, error=HandFileError)
     try:
         schema = _HandSchema.model_validate(raw)
     except ValidationError as err:
@@ -164,6 +151,7 @@ def _finger(f: _FingerSchema) -> Finger:
         alpha=f.alpha,
         beta=f.beta,
         required=f.required,
+        radius=f.radius,
     )
 
 
@@ -208,7 +196,8 @@ def hand_to_toml(hand: Hand, *, comment: str = "") -> str:
             lines.append(f"arc = {{ a_cos = {_float(arc.a_cos)}, a_sin = {_float(arc.a_sin)}, "
                          f"phi_off = {_float(arc.phi_off)} }}")
         lines += [f"travel = {_float(f.travel)}", f"virtual_start = {_float(f.virtual_start)}",
-                  f"alpha = {_float(f.alpha)}", f"beta = {_float(f.beta)}", f"required = {str(f.required).lower()}"]
+                  f"alpha = {_float(f.alpha)}", f"beta = {_float(f.beta)}", f"required = {str(f.required).lower()}",
+                  f"radius = {_float(f.radius)}"]
     return "\n".join(lines) + "\n"
 
 

@@ -6,6 +6,7 @@ import contextlib
 import json
 import os
 import tempfile
+from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +21,8 @@ def _pose(pose) -> dict:
 
 
 def _cost(cost: Cost) -> dict:
-    return {"total": cost.total, "curvature": cost.curvature, "ratio": cost.ratio, "miss": cost.miss}
+    return {"total": cost.total, "curvature": cost.curvature, "ratio": cost.ratio, "miss": cost.miss,
+            "quality": cost.quality}
 
 
 def _xy(point) -> list[float]:
@@ -68,7 +70,12 @@ def plan_to_dict(plan: GraspPlan) -> dict:
             "size": plan.grid_size,
             "feasible": plan.feasible_poses,
         },
+        "safeguards": asdict(plan.safeguards),
+        "quality": asdict(plan.quality),
         "alternatives": [{"pose": _pose(a.pose), "cost": _cost(a.cost)} for a in plan.alternatives],
+        "refinement": None if plan.refinement is None else {
+            "grid_pose": _pose(plan.refinement.grid_pose), "grid_cost": plan.refinement.grid_cost,
+            "cost": plan.refinement.cost, "gain": plan.refinement.gain},
         "timing_ms": dict(plan.timing_ms),
     }
 

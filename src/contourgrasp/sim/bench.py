@@ -35,7 +35,7 @@ from ..io.hand_file import load_hand
 from ..io.plan_file import atomic_outputs, write_json
 from .hand_model import build_hand
 from .objects import THESIS_OBJECTS, ObjectSpec, object_spec
-from .planners import BASELINES, PLANNER_NAMES, SYNTHESIS_PLANNERS, PlannedGrasp, library_defaults, make_planner
+from .planners import BASELINES, PlannedGrasp, ablation_planners, make_planner, synthesis_planner
 from .render import render_view
 from .scene import Camera, Workspace
 from .trial import DROPPED, FAILURE_CAUSES, NO_PLAN, PUSHED, SLIPPED, STRUCK, TrialRecord, run_trial
@@ -46,6 +46,8 @@ THESIS_SUCCESS = {"can": 0.8, "case": 0.4, "bottle": 0.7, "stone1": 0.2, "stone2
 LABELS = {"can": "can", "case": "glasses case", "bottle": "bottle", "stone1": "stone 1", "stone2": "stone 2"}
 #: Short failure causes for the trial tables.
 SHORT_CAUSES = {NO_PLAN: "no plan", STRUCK: "struck", PUSHED: "pushed", SLIPPED: "slipped", DROPPED: "dropped"}
+#: z of the 95 % Wilson interval.
+WILSON_Z = 1.959963984540054
 #: Output file names.
 TABLE, TRIALS, CHART, PICTURE = "table.md", "trials.json", "success.png", "trials.png"
 #: Side view of the end of the hold: distance from the point looked at (m) and the view's elevation (rad).
@@ -61,7 +63,7 @@ class Bench:
     objects : tuple of ObjectSpec
         Distinct names; they head the table's columns.
     planners : tuple of str
-        Names of :data:`~contourgrasp.sim.planners.PLANNER_NAMES`.
+        Planner names (:func:`~contourgrasp.sim.planners.make_planner`).
     trials : int
         Per object and planner.
     seed : int
@@ -75,8 +77,8 @@ class Bench:
     """
 
     objects: tuple[ObjectSpec, ...]
-    planners: tuple[str, ...] = PLANNER_NAMES
-    trials: int = 10
+    planners: tuple[str, ...] = ("paper", "default", *BASELINES)
+    trials: int = 20
     seed: int = 0
     hand: Hand = field(default_factory=lambda: load_hand("five-finger-linear"))
     noise: bool = True
@@ -91,10 +93,10 @@ class Bench:
             raise InputError("no object to grasp")
         if len(set(names)) != len(names):
             raise InputError(f"object names must differ, got {', '.join(names)}")
-        unknown = [p for p in self.planners if p not in PLANNER_NAMES]
-        if unknown or not self.planners or len(set(self.planners)) != len(self.planners):
-            raise InputError(f"planners must be distinct names from {', '.join(PLANNER_NAMES)}, "
-                             f"got {', '.join(self.planners) or 'none'}")
+        if not self.planners or len(set(self.planners)) != len(self.planners):
+            raise InputError(f"planners must be distinct names, got {', '.join(self.planners) or 'none'}")
+        for planner in self.planners:
+            synthesis_planner(planner)  # refuses an unknown name before any trial runs
         if self.trials < 1 or self.seed < 0:
             raise InputError(f"trials must be >= 1 and seed >= 0, got {self.trials} and {self.seed}")
         build_hand(self.hand)  # refuses a hand the simulation cannot build before any trial runs
@@ -313,8 +315,15 @@ def markdown(bench: Bench, results, *, wall_time: float) -> str:
         "",
         "## Success rates",
         "",
+        "Each cell: success rate and its 95 % Wilson interval.",
+        "",
         *rates_table(bench, results),
     ]
+    ablation = ablation_table(bench, results)
+    if ablation:
+        lines += ["", "## Ablation: paper to default", "",
+                  "Each step adds default's value of one group of options to the step above (overall success, its "
+                  "95 % Wilson interval, and failures by cause).", "", *ablation]
     for planner in bench.planners:
         lines += ["", f"## {planner}", "", *trial_table(bench, results, planner), "",
                   f"Causes of failure ({planner}):", "", *cause_table(bench, results, planner)]
@@ -332,33 +341,64 @@ def _setup_text(bench: Bench, n_trials: int, wall_time: float) -> str:
             f"{50 / math.sqrt(bench.trials):.0f} points.")
 
 
+def wilson_interval(successes: int, trials: int, z: float = WILSON_Z) -> tuple[float, float]:
+    """The Wilson score interval of a success rate (95 % for the default ``z``): (low, high) in [0, 1]."""
+    if trials < 1:
+        raise ValueError(f"trials must be >= 1, got {trials}")
+    rate = successes / trials
+    shrink = 1 + z * z / trials
+    centre = (rate + z * z / (2 * trials)) / shrink
+    half = z * math.sqrt(rate * (1 - rate) / trials + z * z / (4 * trials * trials)) / shrink
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
+def _rate_cell(records) -> str:
+    wins = sum(r.success for r in records)
+    low, high = wilson_interval(wins, len(records))
+    return f"{100 * wins / len(records):.0f} % ({100 * low:.0f}–{100 * high:.0f})"
+
+
+def _own(results, planner: str, obj: str | None = None) -> list[TrialRecord]:
+    return [r.record for r in results if r.planner == planner and (obj is None or r.record.object == obj)]
+
+
 def rates_table(bench: Bench, results) -> list[str]:
-    """Success rate per planner (rows) and object (columns), Table 4.4's first."""
+    """Success rate and its 95 % Wilson interval per planner (rows) and object (columns), Table 4.4's first."""
     objects = [o.name for o in bench.objects]
     lines = [*_header("planner", [label(o) for o in objects] + ["all"]),
              _row(["thesis, real robot (Table 4.4)", *map(_percent, thesis_rates(objects).values())])]
     for planner in bench.planners:
-        name = planner + (" (baseline)" if planner not in SYNTHESIS_PLANNERS else "")
-        lines.append(_row([name, *map(_percent, success_rates(results, planner, objects).values())]))
+        name = planner + (" (baseline)" if planner in BASELINES else "")
+        cells = [_rate_cell(_own(results, planner, o)) for o in objects] + [_rate_cell(_own(results, planner))]
+        lines.append(_row([name, *cells]))
     return lines
+
+
+def ablation_table(bench: Bench, results) -> list[str]:
+    """The ablation from ``paper`` to ``default`` (rows in step order, those the bench ran): rates and causes."""
+    steps = [p.name for p in ablation_planners()]
+    names = {name: name for name in steps[:-1]} | {steps[-1]: "default"}
+    rows = [(step, planner) for step, planner in names.items() if planner in bench.planners]
+    lines = _header("step", ["all", *(SHORT_CAUSES[c] for c in FAILURE_CAUSES)])
+    for step, planner in rows:
+        own = _own(results, planner)
+        shown = step if planner == step else f"{step} = `default`"
+        lines.append(_row([shown, _rate_cell(own), *(sum(r.cause == c for r in own) for c in FAILURE_CAUSES)]))
+    return lines if rows else []
 
 
 def planner_notes(bench: Bench, results) -> list[str]:
     """One bullet per planner: what it is, its settings, its median planning time."""
-    keys = sorted({k for options in SYNTHESIS_PLANNERS.values() for k in options})
-    effective = {p: library_defaults(keys) | options for p, options in SYNTHESIS_PLANNERS.items()}
     notes = []
     for planner in bench.planners:
         times = [r.record.plan_time for r in results if r.planner == planner]
         timing = f" Median planning time {statistics.median(times):.2f} s."
-        if planner not in SYNTHESIS_PLANNERS:
+        settings = synthesis_planner(planner)
+        if settings is None:
             notes.append(f"- `{planner}` (baseline): {BASELINES[planner]}.{timing}")
             continue
-        options = SYNTHESIS_PLANNERS[planner]
-        text = ", ".join(f"{k}={_option(k, v)}" for k, v in options.items()) or "the library's defaults"
-        twins = [f"`{p}`" for p in SYNTHESIS_PLANNERS if p != planner and effective[p] == effective[planner]]
-        same = f" (currently the same settings as {', '.join(twins)})" if twins else ""
-        notes.append(f"- `{planner}`: `plan_grasp` with {text}{same}.{timing}")
+        text = ", ".join(f"{k}={_option(k, v)}" for k, v in settings.options) or "the library's defaults"
+        notes.append(f"- `{planner}`: `plan_grasp` with {text}.{timing}")
     return notes
 
 

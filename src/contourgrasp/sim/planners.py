@@ -7,10 +7,12 @@ A planner is what :func:`~contourgrasp.sim.trial.run_trial` calls:
 here also has ``plan(rgb, depth, intrinsics) -> PlannedGrasp``, the same
 answer with what it saw (for figures).
 
-Synthesis planners (:data:`SYNTHESIS_PLANNERS`, name -> keyword options)
+Synthesis planners (:func:`synthesis_planner`)
     :func:`contourgrasp.pipeline.plan_grasp` -- exactly the path a user's camera
-    frames take -- with the given options; ``{}`` means the library's defaults.
-    Add an entry to compare another setting.
+    frames take -- with a planner's options: a preset of
+    :mod:`contourgrasp.io.planner_file` (``paper``, ``default``), a planner TOML
+    file, or a step of the ablation from ``paper`` to ``default``
+    (:func:`ablation_planners`).
 
 Baselines (:data:`BASELINES`), to show whether the bench tells good from bad
     Both use the same perception as ``plan_grasp`` (:func:`perceive`) and no synthesis.
@@ -39,18 +41,21 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from pathlib import Path
+
 from .. import efd, perception, pipeline, synthesis
 from ..errors import InputError, NoFeasibleGrasp
 from ..hand import Hand, Ray, to_image
+from ..io.planner_file import Planner, load_planner, planner_names
 
-#: Synthesis planners: name -> options of :func:`contourgrasp.pipeline.plan_grasp` (``{}``: the library's defaults).
-SYNTHESIS_PLANNERS: dict[str, dict] = {
-    # Thesis: Tables 4.1-4.2 grid, 4 harmonics (4.2.1), curvature as printed, contour plane at the
-    # largest contour depth (eq 3.1-3.2); the gains are the hand's (Table 4.3 for five-finger-linear).
-    "paper": {"harmonics": 4, "curvature": "paper", "xy_step": 0.05, "yaw_step": math.radians(2.0),
-              "d_max": (0.15, 0.15), "d_min": 0.015, "depth_mode": "max"},
-    "default": {},
-}
+#: The ablation from ``paper`` to ``default``: each step takes ``default``'s values of these options.
+ABLATION_STEPS: tuple[tuple[str, tuple[str, ...]], ...] = (
+    ("grid", ("xy_step", "yaw_step", "d_max", "d_min")),
+    ("quality", ("friction", "require_closure", "quality_gain")),
+    ("thickness", ("finger_thickness", "clearance")),
+    ("harmonics", ("harmonics",)),
+    ("refine", ("refine",)),
+)
 #: Baseline planners without synthesis: name -> what it does (module docstring).
 BASELINES = {
     "centroid-principal-axis": "the hand's grasp centre on the contour's centroid, the thumb closing along its "
@@ -58,8 +63,8 @@ BASELINES = {
     "random": "a pose drawn uniformly among the feasible poses of `paper`'s whole search region; "
               "same perception, no synthesis",
 }
-#: Every planner name :func:`make_planner` knows.
-PLANNER_NAMES = (*SYNTHESIS_PLANNERS, *BASELINES)
+#: The planner names :func:`make_planner` knows besides planner files and ablation steps.
+PLANNER_NAMES = (*planner_names(), *BASELINES)
 #: The settings whose search region and constraints the random baseline uses.
 RANDOM_REGION = "paper"
 #: Random poses drawn per batch, and batches tried before giving up.
@@ -145,21 +150,63 @@ class RandomPlanner(_Planner):
         return _planned(pose, segmentation, metric, camera)
 
 
+def ablation_planners() -> tuple[Planner, ...]:
+    """``paper``, then per :data:`ABLATION_STEPS` step ``default``'s values of its options on top of the last.
+
+    Steps are named ``paper+grid``, ``paper+grid+quality``, ...; a step that
+    changes nothing is left out, and the last step has ``default``'s effective options.
+    """
+    paper, default = load_planner("paper"), load_planner("default")
+    options, target = dict(paper.options), dict(default.options)
+    steps, name = [paper], paper.name
+    for step, keys in ABLATION_STEPS:
+        changed = {k: target[k] for k in keys if k in target and options.get(k) != target[k]}
+        if changed:
+            options |= changed
+            name += f"+{step}"
+            steps.append(Planner(name, f"paper with default's {', '.join(changed)}", tuple(options.items())))
+    if options != target:  # options no step names: their own last step, so the last step is default
+        steps.append(Planner(name + "+other", "paper with all of default's options", default.options))
+    return tuple(steps)
+
+
+def synthesis_planner(name: str) -> Planner | None:
+    """The planner a bench name means: a preset, an ablation step or a ``.toml`` file; None for a baseline.
+
+    Raises
+    ------
+    InputError
+        A name that is none of these (or a planner file that does not load).
+    """
+    if name in BASELINES:
+        return None
+    if name in planner_names():
+        return load_planner(name)
+    steps = {p.name: p for p in ablation_planners()}
+    if name in steps:
+        return steps[name]
+    if Path(name).suffix == ".toml":
+        return load_planner(name)
+    raise InputError(f"unknown planner {name!r}: choose from {', '.join(PLANNER_NAMES)}, an ablation step "
+                     f"({', '.join(steps)}) or a planner .toml file")
+
+
 def make_planner(name: str, hand: Hand, *, seed: int = 0) -> _Planner:
-    """The planner called ``name`` (one of :data:`PLANNER_NAMES`) for ``hand``; ``seed`` seeds ``random``.
+    """The planner called ``name`` (see :func:`synthesis_planner`, or a baseline) for ``hand``; ``seed`` seeds ``random``.
 
     Raises
     ------
     InputError
         Unknown name.
     """
-    if name in SYNTHESIS_PLANNERS:
-        return SynthesisPlanner(hand, tuple(SYNTHESIS_PLANNERS[name].items()))
+    planner = synthesis_planner(name)
+    if planner is not None:
+        return SynthesisPlanner(hand, planner.options)
     if name == "centroid-principal-axis":
         return CentroidPlanner(hand)
     if name == "random":
         return RandomPlanner(hand, seed)
-    raise InputError(f"unknown planner {name!r}: choose from {', '.join(PLANNER_NAMES)}")
+    raise AssertionError(f"baseline {name!r} has no planner")  # BASELINES and this function disagree
 
 
 def library_defaults(names) -> dict:
@@ -175,7 +222,7 @@ def library_defaults(names) -> dict:
 def search_settings(name: str) -> dict:
     """Harmonics, curvature and the :class:`~contourgrasp.synthesis.SearchGrid` synthesis planner ``name`` uses."""
     keys = ("harmonics", "curvature", "xy_step", "yaw_step", "d_max", "d_min")
-    options = library_defaults(keys) | {k: v for k, v in SYNTHESIS_PLANNERS[name].items() if k in keys}
+    options = library_defaults(keys) | {k: v for k, v in load_planner(name).options if k in keys}
     grid = synthesis.SearchGrid(**{k: options[k] for k in ("xy_step", "yaw_step", "d_max", "d_min")})
     return {"harmonics": options["harmonics"], "curvature": options["curvature"], "grid": grid}
 

@@ -1,0 +1,39 @@
+"""What hand and planner files share: presets shipped with the package, files named by path, TOML parsing."""
+
+from __future__ import annotations
+
+import tomllib
+from importlib import resources
+from pathlib import Path
+
+
+def preset_names(folder: str) -> list[str]:
+    """Names of the ``*.toml`` presets in the package folder ``folder``, sorted."""
+    directory = resources.files("contourgrasp").joinpath(folder)
+    return sorted(p.name.removesuffix(".toml") for p in directory.iterdir() if p.name.endswith(".toml"))
+
+
+def read_spec(spec: str, folder: str, *, kind: str, error: type[Exception]) -> tuple[str, str]:
+    """The text of preset ``spec`` of ``folder`` or of the file at path ``spec``, and its name for errors.
+
+    Raises ``error`` for a name that is neither a preset nor a file, or a file that cannot be read.
+    """
+    names = preset_names(folder)
+    if spec in names:
+        return resources.files("contourgrasp").joinpath(f"{folder}/{spec}.toml").read_text(encoding="utf-8"), \
+            f"{kind} preset {spec}"
+    path = Path(spec)
+    if not path.suffix and not path.exists():
+        raise error(f"unknown {kind} {spec!r}: not a preset ({', '.join(names)}) nor a file")
+    try:
+        return path.read_text(encoding="utf-8"), str(path)
+    except (OSError, UnicodeDecodeError) as err:
+        raise error(f"{path}: cannot read {kind} file ({err.strerror or err})") from None
+
+
+def parse_toml(text: str, source: str, *, error: type[Exception]) -> dict:
+    """The TOML document ``text``; ``error`` names ``source`` when it is not valid TOML."""
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise error(f"{source}: not valid TOML ({err})") from None

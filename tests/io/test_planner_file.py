@@ -1,0 +1,69 @@
+import json
+import math
+
+import pytest
+
+import contourgrasp as cg
+from contourgrasp.io.planner_file import PlannerFileError, load_planner, parse_planner, planner_names
+from contourgrasp.synthesis import synthesize
+
+
+def test_presets_load_and_paper_is_the_thesis():
+    assert {"paper", "default"} <= set(planner_names())
+    paper = load_planner("paper").plan_options
+    assert paper["harmonics"] == 4 and paper["xy_step"] == 0.05 and paper["d_min"] == 0.015
+    assert paper["yaw_step"] == pytest.approx(math.radians(2.0))
+    assert "depth_mode" in paper and "depth_mode" not in load_planner("paper").synthesis_options
+
+
+@pytest.mark.parametrize("name", ["paper", "default"])
+def test_preset_options_are_accepted_by_synthesis(name):
+    options = load_planner(name).synthesis_options | {"xy_step": 0.03, "yaw_step": math.radians(15)}
+    plan = synthesize(cg.example_contour("case"), cg.load_hand("three-finger"), **options)
+    assert plan.grid.xy_step == 0.03
+
+
+def test_a_file_round_trips_its_options(tmp_path):
+    path = tmp_path / "mine.toml"
+    path.write_text('name = "mine"\nharmonics = "adaptive"\nd_max = [0.1, 0.12]\nfinger_thickness = true\n'
+                    'clearance = 0.005\n')
+    planner = load_planner(str(path))
+    assert planner.name == "mine"
+    assert planner.plan_options == {"harmonics": "adaptive", "d_max": (0.1, 0.12), "finger_thickness": True,
+                                    "clearance": 0.005}
+
+
+@pytest.mark.parametrize("text, field", [
+    ('name = "x"\nxy_step = -0.01', "xy_step"),
+    ('name = "x"\nharmonics = "many"', "harmonics"),
+    ('name = "x"\ncurvature = "wiggly"', "curvature"),
+    ('name = "x"\nspeed = 3', "speed"),
+    ('harmonics = 4', "name"),
+    ('name = "x"\nfinger_thickness = 1', "finger_thickness"),
+])
+def test_bad_files_name_the_field(text, field):
+    with pytest.raises(PlannerFileError, match=f"mine.toml: {field}"):
+        parse_planner(text, source="mine.toml")
+
+
+def test_unknown_planner_and_unreadable_file():
+    with pytest.raises(PlannerFileError, match="unknown planner 'fastest'"):
+        load_planner("fastest")
+    with pytest.raises(PlannerFileError, match="cannot read"):
+        load_planner("/nonexistent/planner.toml")
+
+
+def test_cli_takes_the_planner_and_lets_flags_override_it(tmp_path, capsys):
+    from contourgrasp.cli import main
+
+    out = tmp_path / "plan.json"
+    args = ["synth", "--contour", "example:case", "--hand", "three-finger", "--yaw-step-deg", "15", "--out", str(out)]
+    assert main([*args, "--planner", "paper"]) == 0
+    assert json.loads(out.read_text())["grid"]["xy_step"] == 0.05
+    assert main([*args, "--planner", "paper", "--xy-step", "0.03"]) == 0
+    assert json.loads(out.read_text())["grid"]["xy_step"] == 0.03
+    assert main([*args]) == 0  # the default planner
+    assert json.loads(out.read_text())["grid"]["xy_step"] == dict(load_planner("default").options)["xy_step"]
+    out.unlink()
+    assert main([*args, "--planner", "nosuch"]) == 2
+    assert "unknown planner 'nosuch'" in capsys.readouterr().err and not out.exists()

@@ -1,0 +1,108 @@
+"""Safeguards beyond the thesis: finger thickness and grasp quality in the synthesis."""
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+import contourgrasp as cg
+from contourgrasp import InputError, NoFeasibleGrasp
+from contourgrasp.hand import Finger, Hand, Ray
+from contourgrasp.synthesis import Safeguards, fingers_clear
+
+FAST = {"yaw_step": math.radians(10), "xy_step": 0.02}
+
+
+def circle(radius, n=720):
+    theta = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    return radius * np.stack([np.cos(theta), np.sin(theta)], axis=1)
+
+
+def one_finger(start, direction, *, radius, travel=0.1):
+    finger = Finger("f", start=start, trajectory=Ray(direction), travel=travel, radius=radius)
+    return Hand("one", (finger,), min_touching=1)
+
+
+def test_start_clearance_is_radius_plus_clearance():
+    disc = circle(0.03)
+    hand = one_finger((-0.05, 0.0), (1.0, 0.0), radius=0.01)  # starts 0.02 m from the disc, closing at its centre
+    lam, point = np.array([[0.02]]), np.array([[[-0.03, 0.0]]])
+    pose = np.zeros((1, 3))
+    assert fingers_clear(disc, hand, pose, lam, point, clearance=0.0)[0]
+    assert fingers_clear(disc, hand, pose, lam, point, clearance=0.0099)[0]
+    assert not fingers_clear(disc, hand, pose, lam, point, clearance=0.0101)[0]
+
+
+def test_a_grazing_finger_strikes_the_object_before_its_grasp_point():
+    box = np.array([[0.0, 0.0], [0.1, 0.0], [0.1, 0.04], [0.0, 0.04]])
+    # closing along x at height y = 0.045: the thin finger passes 5 mm above the box, a 9 mm one hits its top
+    hand = one_finger((-0.03, 0.045), (1.0, 0.0), radius=0.009, travel=0.2)
+    missed = np.full((1, 1), np.nan), np.full((1, 1, 2), np.nan)
+    assert not fingers_clear(box, hand, np.zeros((1, 3)), *missed)[0]
+    thin = one_finger((-0.03, 0.045), (1.0, 0.0), radius=0.004, travel=0.2)
+    assert fingers_clear(box, thin, np.zeros((1, 3)), *missed)[0]
+
+
+def test_a_head_on_approach_is_clear_and_the_check_follows_the_pose():
+    box = np.array([[0.0, 0.0], [0.1, 0.0], [0.1, 0.04], [0.0, 0.04]])
+    hand = one_finger((-0.05, 0.02), (1.0, 0.0), radius=0.009)
+    lam, point = np.array([[0.05]]), np.array([[[0.0, 0.02]]])
+    assert fingers_clear(box, hand, np.zeros((1, 3)), lam, point)[0]
+    # turned by 90 deg about the hand origin it starts at (-0.02, -0.05) and closes along +y, 2 cm beside the box
+    turned, missed = np.array([[0.0, 0.0, math.pi / 2]]), (np.full((1, 1), np.nan), np.full((1, 1, 2), np.nan))
+    assert fingers_clear(box, hand, turned, *missed)[0]
+    wide = one_finger((-0.05, 0.02), (1.0, 0.0), radius=0.025)
+    assert not fingers_clear(box, wide, turned, *missed)[0]
+
+
+def test_zero_radius_and_clearance_change_nothing():
+    contour, hand = cg.example_contour("case"), cg.load_hand("three-finger")
+    thin = dataclasses.replace(hand, fingers=tuple(dataclasses.replace(f, radius=0.0) for f in hand.fingers))
+    plain = cg.synthesize(contour, thin, **FAST)
+    checked = cg.synthesize(contour, thin, finger_thickness=True, **FAST)
+    np.testing.assert_array_equal(plain.pose, checked.pose)
+    assert plain.cost == checked.cost
+
+
+def test_thick_fingers_start_clear_of_the_contour():
+    contour = cg.example_contour("can")
+    hand = cg.load_hand("five-finger-linear")
+    plan = cg.synthesize(contour, hand, finger_thickness=True, clearance=0.005, **FAST)
+    samples = cg.efd.sample(plan.efd, 2048)[1]
+    for finger, contact in zip(hand.fingers, plan.fingers, strict=True):
+        gap = np.linalg.norm(samples - contact.start, axis=1).min()
+        assert gap >= finger.radius + 0.005 - 1e-4
+
+
+def test_every_plan_reports_its_quality():
+    plan = cg.synthesize(cg.example_contour("can"), "three-finger", **FAST)
+    assert plan.quality.force_closure and plan.quality.epsilon > 0 and plan.quality.mu == 0.5
+    frictionless = cg.synthesize(cg.example_contour("can"), "three-finger", friction=0.0, **FAST)
+    assert frictionless.quality.epsilon <= plan.quality.epsilon
+
+
+def test_quality_gain_never_lowers_epsilon():
+    # the same candidates ranked with -gain * epsilon added: the chosen epsilon cannot drop
+    contour, hand = cg.example_contour("bottle"), cg.load_hand("five-finger-linear")
+    plain = cg.synthesize(contour, hand, **FAST)
+    graded = cg.synthesize(contour, hand, quality_gain=500.0, **FAST)
+    assert graded.quality.epsilon >= plain.quality.epsilon - 1e-12
+    assert graded.cost.quality == pytest.approx(-500.0 * graded.quality.epsilon)
+    assert graded.cost.total == pytest.approx(graded.cost.curvature + graded.cost.ratio + graded.cost.miss
+                                              + graded.cost.quality)
+
+
+def test_required_closure_holds_or_is_refused():
+    plan = cg.synthesize(cg.example_contour("case"), "five-finger-linear", require_closure=True, **FAST)
+    assert plan.quality.force_closure
+    # one finger alone can never hold an object in force closure
+    lone = one_finger((-0.08, 0.0), (1.0, 0.0), radius=0.0)
+    with pytest.raises(NoFeasibleGrasp, match="force closure"):
+        cg.synthesize(circle(0.03), lone, require_closure=True, **FAST)
+
+
+@pytest.mark.parametrize("option", [{"clearance": -0.01}, {"friction": float("nan")}, {"quality_gain": -1.0}])
+def test_bad_safeguards_are_refused_by_name(option):
+    with pytest.raises(InputError, match=next(iter(option))):
+        Safeguards(**option)
