@@ -16,8 +16,6 @@ The pipeline, one module per stage (thesis chapter 3):
 
 from __future__ import annotations
 
-import math
-
 from . import efd, hand, synthesis
 from .efd import EFD
 from .errors import ContourError, HandFileError, InputError, NoFeasibleGrasp, UnitWarning
@@ -41,6 +39,7 @@ def synthesize(contour_xy, hand, *, planner=None, **options) -> GraspPlan:
 
     Examples
     --------
+    >>> import math
     >>> plan = synthesize(example_contour("can"), "three-finger", yaw_step=math.radians(10))
     >>> plan.grid_size
     1764
