@@ -480,7 +480,10 @@ def evaluate_poses(
     curv[touching] = efd_model.curvature(model, t[touching], curvature)
     clear = np.ones(len(poses), bool)
     if safeguards.finger_thickness:
-        clear = fingers_clear(contour, hand, poses, lam, point, clearance=safeguards.clearance)
+        # chunks bound the (poses, contour points, chords) arrays when the candidate set widens
+        clear = np.concatenate([fingers_clear(contour, hand, poses[rows], lam[rows], point[rows],
+                                              clearance=safeguards.clearance)
+                                for rows in np.array_split(np.arange(len(poses)), -(-len(poses) // tol.POSE_BATCH))])
     epsilon = np.full(len(poses), np.nan)
     if safeguards.grades_quality:
         epsilon = grasp_epsilon(model, point, t, touching, friction=safeguards.friction)

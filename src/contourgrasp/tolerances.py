@@ -67,3 +67,6 @@ HARMONICS_RMS_TOLERANCE = 0.008
 
 #: Default of the "power" rule: share of the first harmonics' power the model may leave out.
 HARMONICS_POWER_TOLERANCE = 2e-4
+
+#: Poses checked at once by the finger-thickness test; bounds its (poses, contour points, chords) arrays.
+POSE_BATCH = 256

@@ -37,11 +37,10 @@ from __future__ import annotations
 import inspect
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import cv2
 import numpy as np
-
-from pathlib import Path
 
 from .. import efd, perception, pipeline, synthesis
 from ..errors import InputError, NoFeasibleGrasp
@@ -165,7 +164,7 @@ def ablation_planners() -> tuple[Planner, ...]:
             options |= changed
             name += f"+{step}"
             steps.append(Planner(name, f"paper with default's {', '.join(changed)}", tuple(options.items())))
-    if options != target:  # options no step names: their own last step, so the last step is default
+    if options != target:  # options outside every step (e.g. curvature) make a last step of their own
         steps.append(Planner(name + "+other", "paper with all of default's options", default.options))
     return tuple(steps)
 
