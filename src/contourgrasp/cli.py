@@ -20,7 +20,7 @@ from . import __version__, efd, synthesize
 from .errors import InputError, NoFeasibleGrasp
 from .io.contour_file import example_contour, example_names, read_contour
 from .io.hand_file import load_hand, preset_names
-from .io.planner_file import PERCEPTION_OPTIONS, load_planner, planner_names
+from .io.planner_file import load_planner, planner_names, synthesis_options
 from .io.plan_file import atomic_outputs, plan_to_dict, write_json
 
 EXIT_OK, EXIT_INPUT, EXIT_INFEASIBLE = 0, 2, 3
@@ -183,10 +183,6 @@ def _plan_options(args) -> dict:
     return load_planner(args.planner).plan_options | {k: v for k, v in given.items() if v is not None}
 
 
-def _synthesis_options(args) -> dict:
-    return {k: v for k, v in _plan_options(args).items() if k not in PERCEPTION_OPTIONS}
-
-
 def _write_outputs(args, data: dict, figure, summary: str) -> None:
     with atomic_outputs(args.out, args.plot) as (out, plot):
         if out is not None:
@@ -215,7 +211,7 @@ def _hands(_args) -> int:
 
 
 def _synth(args) -> int:
-    plan = synthesize(_contour(args.contour), load_hand(args.hand), **_synthesis_options(args))
+    plan = synthesize(_contour(args.contour), load_hand(args.hand), **synthesis_options(_plan_options(args)))
 
     def figure():
         from .visualize import plan_figure

@@ -942,9 +942,14 @@ def _diagnose_exact(result: PoseEvaluation, safeguards: Safeguards) -> str:
 
 
 def _quality(model: EFD, result: PoseEvaluation, i: int, friction: float) -> quality.GraspQuality:
-    """Force closure and L1 epsilon of pose i's grasp points (as :func:`grasp_epsilon` grades them)."""
-    eps = float(grasp_epsilon(model, result.grasp_point[i:i + 1], result.t[i:i + 1], result.touching[i:i + 1],
-                              friction=friction)[0])
+    """Force closure and L1 epsilon of pose i's grasp points (as :func:`grasp_epsilon` grades them).
+
+    The evaluation's own epsilon when the safeguards needed it (same friction and convention), else computed.
+    """
+    eps = float(result.epsilon[i])
+    if np.isnan(eps):
+        eps = float(grasp_epsilon(model, result.grasp_point[i:i + 1], result.t[i:i + 1], result.touching[i:i + 1],
+                                  friction=friction)[0])
     return quality.GraspQuality(force_closure=eps > 0, epsilon=eps, metric="L1", mu=float(friction))
 
 

@@ -93,7 +93,12 @@ class Planner:
     @property
     def synthesis_options(self) -> dict:
         """Keyword options of :func:`contourgrasp.synthesis.synthesize` (perception's left out)."""
-        return {k: v for k, v in self.options if k not in PERCEPTION_OPTIONS}
+        return synthesis_options(dict(self.options))
+
+
+def synthesis_options(options: dict) -> dict:
+    """The options of :func:`contourgrasp.pipeline.plan_grasp` that :func:`contourgrasp.synthesis.synthesize` takes."""
+    return {k: v for k, v in options.items() if k not in PERCEPTION_OPTIONS}
 
 
 def planner_names() -> list[str]:

@@ -273,9 +273,14 @@ def write_outputs(bench: Bench, results, out, *, wall_time: float) -> list[Path]
     return paths
 
 
+def _own(results, planner: str, obj: str | None = None) -> list[TrialRecord]:
+    """The records of ``planner``'s trials (on ``obj`` only, when given)."""
+    return [r.record for r in results if r.planner == planner and (obj is None or r.record.object == obj)]
+
+
 def success_rates(results, planner: str, objects) -> dict[str, float]:
     """Success rate per object name of ``planner``'s trials, and over all of them (key ``"all"``)."""
-    own = [r.record for r in results if r.planner == planner]
+    own = _own(results, planner)
     rates = {o: float(np.mean([r.success for r in own if r.object == o])) for o in objects}
     return rates | {"all": float(np.mean([r.success for r in own]))}
 
@@ -358,10 +363,6 @@ def _rate_cell(records) -> str:
     return f"{100 * wins / len(records):.0f} % ({100 * low:.0f}–{100 * high:.0f})"
 
 
-def _own(results, planner: str, obj: str | None = None) -> list[TrialRecord]:
-    return [r.record for r in results if r.planner == planner and (obj is None or r.record.object == obj)]
-
-
 def rates_table(bench: Bench, results) -> list[str]:
     """Success rate and its 95 % Wilson interval per planner (rows) and object (columns), Table 4.4's first."""
     objects = [o.name for o in bench.objects]
@@ -391,7 +392,7 @@ def planner_notes(bench: Bench, results) -> list[str]:
     """One bullet per planner: what it is, its settings, its median planning time."""
     notes = []
     for planner in bench.planners:
-        times = [r.record.plan_time for r in results if r.planner == planner]
+        times = [r.plan_time for r in _own(results, planner)]
         timing = f" Median planning time {statistics.median(times):.2f} s."
         settings = synthesis_planner(planner)
         if settings is None:
@@ -426,7 +427,7 @@ def trial_table(bench: Bench, results, planner: str) -> list[str]:
 def cause_table(bench: Bench, results, planner: str) -> list[str]:
     """Failures of one planner by cause (rows) and object (columns)."""
     objects = [o.name for o in bench.objects]
-    own = [r.record for r in results if r.planner == planner]
+    own = _own(results, planner)
     lines = _header("cause", [label(o) for o in objects] + ["all"])
     for cause in FAILURE_CAUSES:
         counts = [sum(r.cause == cause for r in own if r.object == o) for o in objects]
