@@ -106,7 +106,12 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def _harmonics(text: str):
-    return text if text == "adaptive" else _positive_int(text)
+    if text == "adaptive":
+        return text
+    try:
+        return _positive_int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a positive integer or 'adaptive', got {text}") from None
 
 
 def _add_synthesis_options(parser) -> None:

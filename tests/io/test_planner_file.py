@@ -67,3 +67,17 @@ def test_cli_takes_the_planner_and_lets_flags_override_it(tmp_path, capsys):
     out.unlink()
     assert main([*args, "--planner", "nosuch"]) == 2
     assert "unknown planner 'nosuch'" in capsys.readouterr().err and not out.exists()
+
+
+def test_cli_harmonics_takes_a_count_or_adaptive(tmp_path, capsys):
+    from contourgrasp.cli import main
+
+    out = tmp_path / "plan.json"
+    args = ["synth", "--contour", "example:stone2", "--yaw-step-deg", "15", "--out", str(out)]
+    assert main([*args, "--harmonics", "adaptive"]) == 0
+    assert json.loads(out.read_text())["efd"]["harmonics"] == 8  # the thesis's count for stone 2
+    out.unlink()
+    with pytest.raises(SystemExit) as exit_:
+        main([*args, "--harmonics", "many"])
+    assert exit_.value.code == 2 and "positive integer or 'adaptive', got many" in capsys.readouterr().err
+    assert not out.exists()
