@@ -99,7 +99,9 @@ def plan_grasp(
     mask : (H, W) bool, optional
         The user's own object mask; skips segmentation.
     depth_mode : {"max", "plane"}
-        Height of the contour's plane (:func:`contourgrasp.perception.contour_to_metric`).
+        Height of the contour's plane (:func:`contourgrasp.perception.contour_to_metric`). With ``"max"``
+        depth segmentation returns the object's footprint when the camera is tilted, planned on the table
+        itself; with ``"plane"`` always the pixels that see the object, planned at the object's top.
     fill_holes : bool
         Fill small depth holes (nearest valid reading) before use.
     approach_offset : float
@@ -159,9 +161,11 @@ def perceive(
         intrinsics.check_shape(np.shape(mask), "mask")
         seg = perception.segment_from_mask(mask)
     else:
-        seg = perception.segment(rgb, d, intrinsics, method=segment)
+        seg = perception.segment(rgb, d, intrinsics, method=segment,
+                                 depth_options={"footprint": False} if depth_mode == "plane" else None)
     metric = perception.contour_to_metric(
-        seg.contour_px, d, intrinsics, depth_mode=depth_mode, plane=seg.plane, offset=approach_offset
+        seg.contour_px, d, intrinsics, depth_mode=depth_mode, plane=seg.plane, on_table=seg.on_table,
+        offset=approach_offset,
     )
     return seg, metric, filled
 

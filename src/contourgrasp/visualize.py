@@ -121,9 +121,11 @@ def image_plan_figure(result, rgb=None) -> Figure:
     plan = result.plan
     fig = Figure(figsize=(16, 7), layout="constrained")
     image_ax, plan_ax = fig.subplots(1, 2, width_ratios=[1.2, 1])
-    image_ax.imshow(rgb if rgb is not None else result.segmentation.mask, cmap="gray")
-    contour = np.vstack([result.segmentation.contour_px, result.segmentation.contour_px[:1]])
-    image_ax.plot(*contour.T, color="yellow", lw=1.2, label=f"contour ({result.segmentation.method})")
+    seg = result.segmentation
+    image_ax.imshow(rgb if rgb is not None else seg.mask, cmap="gray")
+    contour = np.vstack([seg.contour_px, seg.contour_px[:1]])
+    outline = "footprint on the table" if seg.on_table else "contour"
+    image_ax.plot(*contour.T, color="yellow", lw=1.2, label=f"{outline} ({seg.method})")
     for i, (finger, contact) in enumerate(zip(plan.hand.fingers, plan.fingers)):
         colour = FINGER_COLOURS[i % len(FINGER_COLOURS)]
         path = _to_pixels(result, to_image(finger.points(np.linspace(0, finger.travel, 30)), plan.pose))

@@ -96,6 +96,7 @@ def image_plan_to_dict(result) -> dict:
     data["planning_frame"] = {
         "frame": metric.frame,
         "depth_mode": metric.depth_mode,
+        "on_table": metric.on_table,
         "tilt": metric.tilt,
         "z_max": metric.z_max,
         "R_camera_plane": metric.R_camera_plane.tolist(),
