@@ -839,7 +839,7 @@ def object_footprint(mask, depth, intrinsics: Intrinsics, plane: Plane) -> np.nd
 
     Every valid pixel of ``mask`` is back-projected, moved along the table's
     normal onto the table and projected back into the image
-    (:func:`footprint_pixels`); the hit pixels are closed with a 5 x 5 disc,
+    (the rounded pixels they fall on); the hit pixels are closed with a 5 x 5 disc,
     which joins the samples that the object's steep sides spread apart (holes
     are left to the caller, e.g. :func:`segment_depth`'s object picking).
 
@@ -868,18 +868,27 @@ def object_footprint(mask, depth, intrinsics: Intrinsics, plane: Plane) -> np.nd
     (H, W) bool
     """
     rows, cols = np.nonzero(mask & valid_depth(depth))
-    uv = np.rint(footprint_pixels(depth, intrinsics, plane, rows, cols)).astype(int)
-    inside = (uv[:, 0] >= 0) & (uv[:, 0] < mask.shape[1]) & (uv[:, 1] >= 0) & (uv[:, 1] < mask.shape[0])
+    seen, u, v = _in_image(_footprint_pixels(depth, intrinsics, plane, rows, cols), mask.shape)
     hit = np.zeros(mask.shape, dtype=np.uint8)
-    hit[uv[inside, 1], uv[inside, 0]] = 1
+    hit[v[seen], u[seen]] = 1
     return cv2.morphologyEx(hit, cv2.MORPH_CLOSE, _disc(2)) > 0
 
 
-def footprint_pixels(depth, intrinsics: Intrinsics, plane: Plane, rows, cols) -> np.ndarray:
+def _in_image(uv, shape):
+    """Which of the (n, 2) float pixels round to a pixel of an image of ``shape``, and their columns and rows."""
+    seen = np.isfinite(uv).all(axis=1)
+    u, v = np.zeros(len(uv), dtype=int), np.zeros(len(uv), dtype=int)
+    u[seen], v[seen] = np.rint(uv[seen]).astype(int).T
+    seen &= (u >= 0) & (u < shape[1]) & (v >= 0) & (v < shape[0])
+    return seen, u, v
+
+
+def _footprint_pixels(depth, intrinsics: Intrinsics, plane: Plane, rows, cols) -> np.ndarray:
     """(n, 2) float: pixels (u, v) where the points of pixels (rows, cols), moved along the table normal onto the table, are seen."""
     points = _points(depth, intrinsics, rows, cols)
     on_table = points - plane.height(points)[:, None] * plane.normal
-    return intrinsics.project(on_table)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return intrinsics.project(on_table)
 
 
 def add_flat_parts(
@@ -1376,10 +1385,8 @@ def _standing_on(depth, intrinsics, plane, inside, valid):
     with np.errstate(invalid="ignore"):
         above = valid & (_heights(depth, intrinsics, plane) > PLANE_THRESHOLD)
     rows, cols = np.nonzero(above)
-    uv = np.rint(footprint_pixels(depth, intrinsics, plane, rows, cols)).astype(int)
-    height, width = inside.shape
-    keep = (uv[:, 0] >= 0) & (uv[:, 0] < width) & (uv[:, 1] >= 0) & (uv[:, 1] < height)
-    keep[keep] = inside[uv[keep, 1], uv[keep, 0]]
+    keep, u, v = _in_image(_footprint_pixels(depth, intrinsics, plane, rows, cols), inside.shape)
+    keep[keep] = inside[v[keep], u[keep]]
     table_rows, table_cols = np.nonzero(inside & valid & ~above)
     if not keep.any() and not len(table_rows):
         return np.nonzero(inside & valid)
