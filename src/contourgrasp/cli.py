@@ -87,7 +87,8 @@ def _parser() -> argparse.ArgumentParser:
     plan.add_argument("--segment", choices=("auto", "rgb", "depth"), default="auto")
     plan.add_argument("--mask", help="binary image of the object: skips segmentation")
     plan.add_argument("--depth-mode", choices=("max", "plane"),
-                      help="contour plane: 'max' (thesis eq 3.1-3.2) or the object's top 'plane' (default: the planner's)")
+                      help="contour plane: 'max' (thesis eq 3.1-3.2; the footprint on the table when the camera is "
+                           "tilted) or the object's top 'plane' (default: the planner's)")
     plan.add_argument("--no-fill-holes", action="store_true", help="do not fill small depth holes")
     plan.add_argument("--approach-offset", type=float, default=0.01, help="added to the nearest depth, m")
     plan.add_argument("--standoff", type=_non_negative_float, default=0.10, help="pre-grasp distance, m")
