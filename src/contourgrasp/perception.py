@@ -62,9 +62,9 @@ Readings of ours (where the thesis is silent)
 * Footprint. With a tilted camera the depth region is replaced by the
   object's footprint on the table (:func:`object_footprint`,
   :func:`segment_depth`): what the hand-made masks outline, and what a hand
-  approaching along the table's normal closes on. The colour image sits 4-6
-  px below the depth image on the shared frames; the offset estimated from
-  the images varies between frames, so no shift is applied.
+  approaching along the table's normal closes on. Colour and depth are
+  registered on the shared frames (their outlines' far edges agree to the
+  pixel), so colour evidence is used where it is seen, unshifted.
 * Tilted cameras: see :func:`contour_to_metric`.
 """
 
