@@ -67,6 +67,17 @@ def test_derivatives_match_finite_differences(k):
     np.testing.assert_allclose(efd.evaluate(model, t, k), numeric, rtol=1e-4, atol=1e-6)
 
 
+def test_derivatives_together_are_evaluate_to_the_last_bit():
+    model = efd.fit(example_contour("peanut"), harmonics=7)
+    t = np.random.default_rng(5).uniform(-0.1, 2 * model.T, 300)
+    together = efd.evaluate_derivatives(model, t, (2, 0, 1))
+    for order, values in zip((2, 0, 1), together):
+        np.testing.assert_array_equal(values, efd.evaluate(model, t, order))
+    for mode in efd.CURVATURE_MODES:
+        np.testing.assert_array_equal(efd.curvature_from_derivatives(together[2], together[0], model.T, mode),
+                                      efd.curvature(model, t, mode))
+
+
 def test_circle_curvature(circle):
     model = efd.fit(circle)
     t = np.linspace(0, model.T, 100, endpoint=False)

@@ -193,6 +193,15 @@ def test_qhull_and_plane_enumeration_agree(grasp):
     assert q.epsilon_many(p[None], n[None], mu=mu)[0] == pytest.approx(q.epsilon(p, n, mu=mu), abs=1e-9)
 
 
+def test_plane_enumeration_of_wrenches_on_one_line_is_zero():
+    """Two contacts one ulp apart and a third, frictionless: the wrenches lie on one line (no
+    closure), and every triple's plane is rounding noise that passes the one-side test."""
+    p = np.array([[0.033768894116758735, 0.026295968275246766], [0.0625, -7.654042494670958e-18], [0.0625, 0.0]])
+    n = np.array([[-8.644836893890236, -26.927071513852688], [-16.0, 7.83773951454306e-15], [-16.0, 0.0]])
+    assert q.epsilon(p, n, mu=0.0) == 0.0
+    assert q.epsilon_many(p[None], n[None], mu=0.0)[0] == 0.0
+
+
 @given(grasps())
 @settings(max_examples=150, deadline=None)
 def test_force_closure_agrees_with_the_lp(grasp):

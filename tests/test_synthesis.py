@@ -1,3 +1,4 @@
+import dataclasses
 import math
 
 import numpy as np
@@ -98,11 +99,13 @@ def test_first_touch_matches_brute_force_marching():
 
 
 @pytest.mark.parametrize("hand", cg.preset_names())
-def test_compiled_grid_screen_matches_the_numpy_inner_problem(hand):
-    """Same polygon, same arithmetic: the bucketed kernel must find exactly what brute force finds."""
+@pytest.mark.parametrize("steps", [(0.03, 7), (0.05, 9)])
+def test_compiled_grid_screen_matches_the_numpy_inner_problem(hand, steps):
+    """Same polygon, same arithmetic: the filtered kernel must find exactly what brute force finds
+    (edge groups in buckets on the finer grid, scanned on the coarser one)."""
     hand = cg.load_hand(hand)
     model = efd.fit(cg.example_contour("stone1"))
-    grid = synthesis.SearchGrid(xy_step=0.03, yaw_step=math.radians(7))
+    grid = synthesis.SearchGrid(xy_step=steps[0], yaw_step=math.radians(steps[1]))
     screen = synthesis.screen_grid(model, hand, grid)
     t, polygon = efd.sample(model)
     lam, t_hit, _, inside = synthesis.first_touch(polygon, t, model.T, hand.segments(), len(hand.fingers), screen.poses)
@@ -174,8 +177,9 @@ def test_screen_curvature_tables_match_the_curve(mode):
     np.testing.assert_allclose(table[same], exact[same], rtol=1e-3, atol=2e-3 * np.abs(exact).max())
 
 
-def test_nearest_point_segment_matches_numpy():
-    rng = np.random.default_rng(4)
+@pytest.mark.parametrize("seed", [4, 7, 8])
+def test_nearest_point_segment_matches_numpy(seed):
+    rng = np.random.default_rng(seed)
     points, starts, vectors = rng.normal(size=(30, 2)), rng.normal(size=(20, 2)), rng.normal(size=(20, 2))
     w = points[:, None] - starts[None]
     s = np.clip(np.einsum("nsi,si->ns", w, vectors) / np.sum(vectors**2, axis=1), 0, 1)
@@ -265,6 +269,40 @@ def test_alternatives_are_ranked_distinct_and_start_with_the_best():
             d = np.abs(poses[i] - poses[j])
             d[2] = min(d[2], 2 * math.pi - d[2])
             assert (d[:2] > plan.grid.xy_step * 1.000001).any() or d[2] > plan.grid.yaw_step * 1.000001
+
+
+@pytest.mark.parametrize("block", [3, 512])
+def test_distinct_best_is_the_greedy_choice(block):
+    """Cheapest first, skipping neighbours of those taken, whatever the blocks compared at once."""
+    grid = synthesis.SearchGrid(xy_step=0.05, yaw_step=math.radians(10))
+    rng = np.random.default_rng(6)
+    poses = np.c_[rng.integers(0, 4, (60, 2)) * grid.xy_step, rng.integers(0, 36, 60) * grid.yaw_step]
+    cost = rng.integers(0, 20, 60).astype(float)  # ties: the first pose wins
+    feasible = rng.random(60) < 0.8
+    result = synthesis.PoseEvaluation(**{f.name: None for f in dataclasses.fields(synthesis.PoseEvaluation)}
+                                      | {"poses": poses, "cost": cost, "feasible": feasible})
+    expected = []
+    for i in sorted(np.flatnonzero(feasible), key=lambda i: (cost[i], i)):
+        near = [np.all(np.abs(poses[i, :2] - poses[j, :2]) <= grid.xy_step * 1.000001)
+                and min(abs(poses[i, 2] - poses[j, 2]), 2 * math.pi - abs(poses[i, 2] - poses[j, 2]))
+                <= grid.yaw_step * 1.000001 for j in expected]
+        if not any(near):
+            expected.append(int(i))
+    assert len(expected) > 8
+    assert synthesis._distinct_best(result, grid, 8, block=block) == expected[:8]
+    assert synthesis._distinct_best(result, grid, 100, block=block) == expected
+
+
+def test_derived_arrays_are_computed_once_and_go_with_their_model():
+    model = efd.fit(cg.example_contour("can"))
+    polygon = synthesis._polygon(model)
+    assert synthesis._polygon(model) is polygon
+    np.testing.assert_array_equal(polygon[1], efd.sample(model)[1])
+    twin = efd.fit(cg.example_contour("can"))
+    assert synthesis._polygon(twin) is not polygon
+    key = id(model)
+    del model
+    assert key not in synthesis._DERIVED
 
 
 def test_deterministic():

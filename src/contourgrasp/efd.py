@@ -221,17 +221,39 @@ def evaluate(model: EFD, t, derivative: int = 0) -> np.ndarray:
     -------
     (m, 2) float
     """
+    return evaluate_derivatives(model, t, (derivative,))[0]
+
+
+def evaluate_derivatives(model: EFD, t, derivatives) -> list[np.ndarray]:
+    """:func:`evaluate` for several derivatives at the same parameters, e.g. ``(0, 1)``: the point and tangent.
+
+    Each equals :func:`evaluate` of that derivative to the last bit; the harmonics' phases are
+    computed once for all (the planner's Newton steps and curvature need pairs).
+
+    Returns
+    -------
+    list of (m, 2) float
+        In the order of ``derivatives``.
+    """
     t = np.atleast_1d(np.asarray(t, dtype=float))
-    n = np.arange(1, model.harmonics + 1)
-    w = 2.0 * np.pi * n / model.T
-    phase = np.outer(t, w) + derivative * np.pi / 2  # d/dt cos(wt) = w cos(wt + pi/2)
-    scale = w**derivative
-    cos, sin = np.cos(phase) * scale, np.sin(phase) * scale
+    w = 2.0 * np.pi * np.arange(1, model.harmonics + 1) / model.T
+    wt = t[:, None] * w
     a, b, c, d = model.coefficients.T
-    xy = np.stack([cos @ a + sin @ b, cos @ c + sin @ d], axis=-1)
-    if derivative == 0:
-        xy += model.locus
-    return xy
+    out = []
+    for derivative in derivatives:
+        phase = wt + derivative * np.pi / 2  # d/dt cos(wt) = w cos(wt + pi/2)
+        cos, sin = np.cos(phase), np.sin(phase)
+        if derivative:
+            scale = w**derivative
+            cos *= scale
+            sin *= scale
+        xy = np.empty((len(t), 2))
+        xy[:, 0] = cos @ a + sin @ b
+        xy[:, 1] = cos @ c + sin @ d
+        if derivative == 0:
+            xy += model.locus
+        out.append(xy)
+    return out
 
 
 def sample(model: EFD, count: int = tol.EFD_SAMPLES) -> tuple[np.ndarray, np.ndarray]:
@@ -265,13 +287,19 @@ def curvature(model: EFD, t, mode: CurvatureMode = "paper") -> np.ndarray:
     """
     if mode not in CURVATURE_MODES:
         raise ValueError(f"curvature mode must be one of {CURVATURE_MODES}, got {mode!r}")
-    d1 = evaluate(model, t, 1)
-    d2 = evaluate(model, t, 2)
+    return curvature_from_derivatives(*evaluate_derivatives(model, t, (1, 2)), model.T, mode)
+
+
+def curvature_from_derivatives(d1: np.ndarray, d2: np.ndarray, period: float, mode: CurvatureMode = "paper"):
+    """:func:`curvature` from the first and second derivatives (m, 2) at the parameters, for callers that have them.
+
+    ``period`` is the model's T (the ``"paper"`` flavour differentiates with respect to t / T).
+    """
     if mode == "geometric":
         speed = np.linalg.norm(d1, axis=1)
         return _cross(d1, d2) / np.maximum(speed, np.finfo(float).tiny) ** 3
     sign = np.where(_cross(d1, d2) < 0, -1.0, 1.0)
-    return sign * np.linalg.norm(d2, axis=1) * model.T**2
+    return sign * np.linalg.norm(d2, axis=1) * period**2
 
 
 def concave(model: EFD, t, mode: CurvatureMode = "paper") -> np.ndarray:

@@ -313,7 +313,12 @@ def _ball_radius_batch(w: np.ndarray, ok: np.ndarray) -> np.ndarray:
     distance of the origin to such a plane (negative when it is outside).
     A near-degenerate triple gives a poorly defined plane, but one that still
     passes the one-side test is a supporting plane, whose distance is never
-    below the true radius: such planes cannot make the answer wrong.
+    below the true radius: such planes cannot make the answer too small. A
+    triple spanning no plane at all (:data:`tolerances.WRENCH_PLANE`) is
+    skipped: where every triple is such (the wrenches on one line, e.g. two
+    coincident contacts and a third without friction), a plane through it at
+    any angle would pass the one-side test and report a radius the flat set
+    does not have.
     """
     g, m, _ = w.shape
     out = np.zeros(g)
@@ -326,7 +331,7 @@ def _ball_radius_batch(w: np.ndarray, ok: np.ndarray) -> np.ndarray:
         a = ws[:, i]
         normal = np.cross(ws[:, j] - a, ws[:, k] - a)
         length = np.linalg.norm(normal, axis=-1)
-        usable = oks[:, i] & oks[:, j] & oks[:, k] & (length > 0.0)
+        usable = oks[:, i] & oks[:, j] & oks[:, k] & (length > tol.WRENCH_PLANE)
         unit = normal / np.where(usable, length, 1.0)[..., None]
         h = np.einsum("gtd,gtd->gt", unit, a)  # the plane is unit . x = h
         side = np.einsum("gtd,gmd->gtm", unit, ws) - h[..., None]

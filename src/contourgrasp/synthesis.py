@@ -45,6 +45,7 @@ from __future__ import annotations
 
 import math
 import time
+import weakref
 from dataclasses import dataclass, fields
 from typing import Literal
 
@@ -104,8 +105,10 @@ class SearchGrid:
 
     def poses(self, locus) -> np.ndarray:
         """(p, 3) float: every (x, y, yaw) of the grid around ``locus`` (2,), yaw varying fastest."""
-        x, y, yaw = np.meshgrid(*self.axes(locus), indexing="ij")
-        return np.stack([x.ravel(), y.ravel(), yaw.ravel()], axis=1)
+        x, y, yaw = self.axes(locus)
+        poses = np.empty((len(x), len(y), len(yaw), 3))
+        poses[..., 0], poses[..., 1], poses[..., 2] = x[:, None, None], y[:, None], yaw
+        return poses.reshape(-1, 3)
 
 
 @dataclass(frozen=True)
@@ -329,6 +332,78 @@ class GraspPlan:
     quality: quality.GraspQuality
 
 
+#: Values derived from an object (a model, a hand) by :func:`_cached`: id -> (weak reference, {kind: value}).
+_DERIVED: dict = {}
+
+
+def _cached(owner, kind, build):
+    """``build()``, computed once per ``owner`` (by identity) and ``kind``; the entry goes with its owner.
+
+    Every stage of a plan (and every round of the refinement) needs the same polygon of its model
+    and the same arrays of its hand; they are shared between them, so callers must not modify them.
+    """
+    key = id(owner)
+    entry = _DERIVED.get(key)
+    if entry is None or entry[0]() is not owner:
+        entry = _DERIVED[key] = (weakref.ref(owner, lambda _, key=key: _DERIVED.pop(key, None)), {})
+    values = entry[1]
+    if kind not in values:
+        values[kind] = build()
+    return values[kind]
+
+
+def _polygon(model: EFD, samples: int = tol.EFD_SAMPLES) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`contourgrasp.efd.sample` of ``model``, computed once per model and count (:func:`_cached`)."""
+    return _cached(model, ("polygon", samples), lambda: _read_only(*efd_model.sample(model, samples)))
+
+
+def _read_only(*arrays: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The arrays, made read-only: cached values are shared, and a write to one would leak into later plans."""
+    for a in arrays:
+        a.setflags(write=False)
+    return arrays
+
+
+@dataclass(frozen=True, eq=False)
+class _HandArrays:
+    """A hand's fingers as the arrays the search needs (:func:`_hand_arrays`); rows are fingers.
+
+    ``rays``: closing directions, NaN for fingers on arcs; ``first``: (s,) bool, the chord is its finger's first.
+    """
+
+    segments: HandSegments
+    first: np.ndarray
+    starts: np.ndarray
+    virtual_starts: np.ndarray
+    alpha: np.ndarray
+    beta: np.ndarray
+    required: np.ndarray
+    travel: np.ndarray
+    rays: np.ndarray
+
+
+def _hand_arrays(hand: Hand) -> _HandArrays:
+    """The :class:`_HandArrays` of ``hand``, built once (:func:`_cached`)."""
+    return _cached(hand, "arrays", lambda: _build_hand_arrays(hand))
+
+
+def _build_hand_arrays(hand: Hand) -> _HandArrays:
+    """The :class:`_HandArrays` of ``hand``, from its fingers."""
+    segments = hand.segments()
+    fingers = hand.fingers
+    return _HandArrays(segments, *_read_only(
+        _first_chords(segments, len(fingers)),
+        np.array(hand.starts, dtype=float),
+        np.array(hand.virtual_starts, dtype=float),
+        np.array([f.alpha for f in fingers], dtype=float),
+        np.array([f.beta for f in fingers], dtype=float),
+        np.array([f.required for f in fingers]),
+        np.array([f.travel for f in fingers], dtype=float),
+        np.array([f.trajectory.closing_direction if isinstance(f.trajectory, Ray) else (np.nan, np.nan)
+                  for f in fingers]),
+    ))
+
+
 def first_touch(
     contour: np.ndarray, contour_t: np.ndarray, period: float, segments: HandSegments, n_fingers: int, poses: np.ndarray
 ):
@@ -467,12 +542,12 @@ def evaluate_poses(
     PoseEvaluation
     """
     poses = np.atleast_2d(np.asarray(poses, dtype=float))
-    contour_t, contour = efd_model.sample(model, samples)
-    segments = hand.segments()
-    n_f = len(hand.fingers)
+    contour_t, contour = _polygon(model, samples)
+    arrays = _hand_arrays(hand)
+    segments, n_f = arrays.segments, len(hand.fingers)
     lam, t, point, start_inside = pose_first_touch(
         contour, contour_t, model.T, poses, segments.start, segments.end - segments.start, segments.finger,
-        segments.lam0, _first_chords(segments, n_f), n_f, tol.PARALLEL,
+        segments.lam0, arrays.first, n_f, tol.PARALLEL,
     )
     touching = np.isfinite(lam)
     t, lam, point = _newton(model, hand, poses, t, lam, point, touching, model.T / samples)
@@ -502,26 +577,25 @@ def screen_grid(
     exactly. The inner loop is the compiled :func:`contourgrasp._kernels.grid_first_touch`.
     """
     xs, ys, yaws = grid.axes(model.locus)
-    contour_t, contour = efd_model.sample(model, samples)
-    seg = hand.segments()
-    n_f = len(hand.fingers)
-    first = _first_chords(seg, n_f)
+    contour_t, contour = _polygon(model, samples)
+    arrays = _hand_arrays(hand)
+    seg, n_f = arrays.segments, len(hand.fingers)
     lam, t, point, start_inside = grid_first_touch(
-        contour, contour_t, model.T, xs, ys, yaws, seg.start, seg.end - seg.start, seg.finger, seg.lam0, first, n_f,
-        tol.PARALLEL,
+        contour, contour_t, model.T, xs, ys, yaws, seg.start, seg.end - seg.start, seg.finger, seg.lam0, arrays.first,
+        n_f, tol.PARALLEL,
     )
     # The paper's curvature jumps where the contour turns from convex to concave; its magnitude and
     # the turning direction r' x r'' do not, so they are tabulated and interpolated apart.
     table_t = np.linspace(0.0, model.T, tol.CURVATURE_TABLE, endpoint=False)
-    d1, d2 = efd_model.evaluate(model, table_t, 1), efd_model.evaluate(model, table_t, 2)
+    d1, d2 = efd_model.evaluate_derivatives(model, table_t, (1, 2))
     turn = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
-    magnitude = np.abs(efd_model.curvature(model, table_t, curvature))
+    magnitude = np.abs(efd_model.curvature_from_derivatives(d1, d2, model.T, curvature))
     curv = interpolate_curvature(magnitude, turn, t, model.T)
     touching = np.isfinite(lam)
     poses = grid.poses(model.locus)
     n = len(poses)
     return _assemble(hand, poses, touching, np.where(touching, lam, np.nan), t, point, curv, start_inside,
-                     grid.d_min, np.ones(n, bool), np.full(n, np.nan), Safeguards())
+                     grid.d_min, np.ones(n, bool), np.full(n, np.nan), Safeguards(), n_yaw=len(yaws))
 
 
 def refine_poses(
@@ -642,9 +716,10 @@ def _newton(model: EFD, hand: Hand, poses, t, lam, point, touching, t_step, iter
     R = rotation(poses[rows, 2])
     xy = poses[rows, :2]
     t_i, lam_i = t[rows, fingers], lam[rows, fingers]
+    paths = _Paths(hand, fingers)
     for _ in range(iterations):
-        local, direction = _trajectory(hand, fingers, lam_i)
-        r, dr = efd_model.evaluate(model, t_i), efd_model.evaluate(model, t_i, 1)
+        local, direction = paths.at(lam_i)
+        r, dr = efd_model.evaluate_derivatives(model, t_i, (0, 1))
         F = r - xy - np.einsum("pij,pj->pi", R, local)
         dp = np.einsum("pij,pj->pi", R, direction)
         det = -dr[:, 0] * dp[:, 1] + dp[:, 0] * dr[:, 1]
@@ -654,10 +729,10 @@ def _newton(model: EFD, hand: Hand, poses, t, lam, point, touching, t_step, iter
         t_i, lam_i = t_i + step_t, lam_i + step_lam
         if not (np.abs(step_t) > 1e-12).any() and not (np.abs(step_lam) > 1e-12).any():
             break
-    local, _ = _trajectory(hand, fingers, lam_i)
+    local, _ = paths.at(lam_i, tangents=False)
     r = efd_model.evaluate(model, t_i)
     residual = np.linalg.norm(r - xy - np.einsum("pij,pj->pi", R, local), axis=1)
-    travel = np.array([f.travel for f in hand.fingers])[fingers]
+    travel = _hand_arrays(hand).travel[fingers]
     ok = (residual < 1e-9) & (lam_i >= 0) & (lam_i <= travel) & (np.abs(t_i - t[rows, fingers]) < 2 * t_step)
     rows, fingers = rows[ok], fingers[ok]
     t[rows, fingers] = t_i[ok] % model.T
@@ -666,28 +741,41 @@ def _newton(model: EFD, hand: Hand, poses, t, lam, point, touching, t_step, iter
     return t, lam, point
 
 
-def _trajectory(hand: Hand, fingers, lam) -> tuple[np.ndarray, np.ndarray]:
-    """Hand-frame points and unit tangents (both (n, 2)) of finger ``fingers`` (n,) int after travelling ``lam`` (n,).
+class _Paths:
+    """The trajectories of fingers ``fingers`` (n,) int of a hand, evaluated together at every Newton step.
 
-    Rays in one expression (this runs in every Newton step), arcs finger by finger.
+    Rays in one expression, arcs finger by finger; what does not change between steps is indexed once.
     """
-    rays = np.array([f.trajectory.closing_direction if isinstance(f.trajectory, Ray) else (np.nan, np.nan)
-                     for f in hand.fingers])
-    tangents = rays[fingers]
-    points = hand.starts[fingers] + lam[:, None] * tangents
-    for f in np.unique(fingers[np.isnan(tangents[:, 0])]):
-        rows = fingers == f
-        points[rows], tangents[rows] = hand.fingers[f].points(lam[rows]), hand.fingers[f].tangent(lam[rows])
-    return points, tangents
+
+    def __init__(self, hand: Hand, fingers: np.ndarray):
+        arrays = _hand_arrays(hand)
+        self.starts, self.rays = arrays.starts[fingers], arrays.rays[fingers]
+        on_arcs = np.unique(fingers[np.isnan(self.rays[:, 0])])
+        self.arcs = [(hand.fingers[f], fingers == f) for f in on_arcs]
+
+    def at(self, lam, tangents: bool = True) -> tuple[np.ndarray, np.ndarray]:
+        """Hand-frame points and unit tangents (both (n, 2)) after travelling ``lam`` (n,); tangents of arcs
+        only if ``tangents``."""
+        direction = self.rays.copy()
+        points = self.starts + lam[:, None] * direction
+        for finger, rows in self.arcs:
+            points[rows] = finger.points(lam[rows])
+            if tangents:
+                direction[rows] = finger.tangent(lam[rows])
+        return points, direction
 
 
 def _assemble(hand: Hand, poses, touching, lam, t, point, curv, start_inside, d_min, clear, epsilon,
-              safeguards: Safeguards) -> PoseEvaluation:
-    """Constraints 3.39-3.41 and the cost of eq 3.34 (plus the safeguards') from the inner problem's solutions."""
+              safeguards: Safeguards, n_yaw: int | None = None) -> PoseEvaluation:
+    """Constraints 3.39-3.41 and the cost of eq 3.34 (plus the safeguards') from the inner problem's solutions.
+
+    ``n_yaw``: the period of the poses' yaws, for a grid (yaw fastest); None for any list of poses.
+    """
+    arrays = _hand_arrays(hand)
     (distance, start_distance, outside, reaches, far_enough, cost_curvature, cost_ratio, cost_miss) = score_poses(
-        poses, touching, point, curv, start_inside, hand.starts, hand.virtual_starts,
-        np.array([f.alpha for f in hand.fingers], dtype=float), np.array([f.beta for f in hand.fingers], dtype=float),
-        np.array([f.required for f in hand.fingers]), hand.min_touching, float(hand.miss_penalty), float(d_min),
+        poses, len(poses) if n_yaw is None else n_yaw, touching, point, curv, start_inside, arrays.starts,
+        arrays.virtual_starts, arrays.alpha, arrays.beta, arrays.required, hand.min_touching, float(hand.miss_penalty),
+        float(d_min),
     )
     feasible = outside & reaches & far_enough & clear
     if safeguards.require_closure:
@@ -780,8 +868,7 @@ def grasp_epsilon(model: EFD, grasp_point, t, touching, *, friction: float = 0.5
     """
     normals = quality.contour_normals(model, np.where(touching, t, 0.0))
     valid = touching & np.isfinite(normals).all(axis=-1)
-    _, polygon = efd_model.sample(model)
-    rho = float(np.linalg.norm(polygon - model.locus, axis=1).max())
+    rho = _cached(model, "rho", lambda: float(np.linalg.norm(_polygon(model)[1] - model.locus, axis=1).max()))
     return quality.epsilon_many(grasp_point, normals, valid, mu=friction, centre=model.locus, rho=rho)
 
 
@@ -963,23 +1050,34 @@ def _cost(result: PoseEvaluation, i: int) -> Cost:
     )
 
 
-def _distinct_best(result: PoseEvaluation, grid: SearchGrid, k: int) -> list[int]:
-    """Indices of the k cheapest feasible poses, skipping grid neighbours of those already taken."""
+def _distinct_best(result: PoseEvaluation, grid: SearchGrid, k: int, block: int = 512) -> list[int]:
+    """Indices of the k cheapest feasible poses, skipping grid neighbours of those already taken.
+
+    Candidates are compared with each other ``block`` at a time, in increasing cost.
+    """
     candidates = np.flatnonzero(result.feasible)
     order = candidates[np.argsort(result.cost[candidates], kind="stable")]
     taken: list[int] = []
-    slack = 1.0 + 1e-6
-    for i in order:
-        if taken:
-            delta = np.abs(result.poses[taken] - result.poses[i])
-            delta[:, 2] = np.minimum(delta[:, 2], 2 * math.pi - delta[:, 2])
-            near = (delta[:, :2] <= grid.xy_step * slack).all(axis=1) & (delta[:, 2] <= grid.yaw_step * slack)
-            if near.any():
+    for start in range(0, len(order), block):
+        rows = order[start:start + block]
+        blocked = _neighbours(result.poses[rows], result.poses[taken], grid).any(axis=1)
+        near = _neighbours(result.poses[rows], result.poses[rows], grid)
+        for j, i in enumerate(rows.tolist()):
+            if blocked[j]:
                 continue
-        taken.append(int(i))
-        if len(taken) == k:
-            break
+            taken.append(i)
+            if len(taken) == k:
+                return taken
+            blocked |= near[j]
     return taken
+
+
+def _neighbours(a: np.ndarray, b: np.ndarray, grid: SearchGrid) -> np.ndarray:
+    """(len(a), len(b)) bool: poses a (n, 3) and b (m, 3) are grid neighbours in x, y and yaw at once."""
+    delta = np.abs(a[:, None, :] - b[None, :, :])
+    delta[..., 2] = np.minimum(delta[..., 2], 2 * math.pi - delta[..., 2])
+    slack = 1.0 + 1e-6
+    return (delta[..., :2] <= grid.xy_step * slack).all(axis=-1) & (delta[..., 2] <= grid.yaw_step * slack)
 
 
 def _diagnose(result: PoseEvaluation, hand: Hand, grid: SearchGrid) -> str:
@@ -1000,8 +1098,9 @@ def _diagnose(result: PoseEvaluation, hand: Hand, grid: SearchGrid) -> str:
 
 def _contacts(model: EFD, hand: Hand, result: PoseEvaluation, i: int, mode: CurvatureMode):
     pose = result.poses[i]
-    starts = to_image(hand.starts, pose)
-    virtual = to_image(hand.virtual_starts, pose)
+    arrays = _hand_arrays(hand)
+    starts = to_image(arrays.starts, pose)
+    virtual = to_image(arrays.virtual_starts, pose)
     found = []
     for f, finger in enumerate(hand.fingers):
         if result.touching[i, f]:
@@ -1048,7 +1147,7 @@ def closest_approach(model: EFD, finger, pose, samples: int = tol.EFD_SAMPLES, c
     """
     lam = np.linspace(0.0, finger.travel, chords + 1)
     path = to_image(finger.points(lam), pose)
-    t, contour = efd_model.sample(model, samples)
+    t, contour = _polygon(model, samples)
     edges = np.roll(contour, -1, axis=0) - contour
     steps = np.diff(path, axis=0)
     # path vertices against contour edges, then contour vertices against path chords

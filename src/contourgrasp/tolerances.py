@@ -54,6 +54,10 @@ REFINE_ROUNDS = 40
 #: still counts as on it.
 WRENCH_ZERO = 1e-9
 
+#: Three wrenches whose triangle is smaller than this (|cross product|, twice its area; wrenches are
+#: of order 1) span no plane: the plane enumeration of the epsilon metric skips them.
+WRENCH_PLANE = 1e-12
+
 #: A contact normal shorter than this has no direction.
 MIN_NORMAL = 1e-12
 
