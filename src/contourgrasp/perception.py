@@ -293,7 +293,7 @@ class Segmentation:
     filled_px : int
         Depth pixels filled by :func:`fill_depth_holes` before segmenting.
     on_table : bool
-        The mask is the object's footprint (:func:`footprint`): drawn where
+        The mask is the object's footprint (:func:`object_footprint`): drawn where
         the table is, not where the camera sees the object.
     """
 
@@ -1005,16 +1005,12 @@ def _dilate(mask, radius):
     return _morph(cv2.MORPH_DILATE, mask, radius)
 
 
-def _erode(mask, radius):
-    return _morph(cv2.MORPH_ERODE, mask, radius)
-
-
 def _open(mask, radius):
     return _morph(cv2.MORPH_OPEN, mask, radius)
 
 
 def _morph(operation, mask, radius):
-    """(H, W) bool: ``mask`` dilated, eroded or opened by a disc, as OpenCV does it on the whole image.
+    """(H, W) bool: ``mask`` dilated or opened by a disc, as OpenCV does it on the whole image.
 
     The operation runs on the mask's bounding box grown by ``radius`` only: the
     result is empty farther out, and within the box every disc around a mask
