@@ -263,6 +263,26 @@ def test_auto_ignores_a_shadow_band_along_the_depth_outline():
     np.testing.assert_array_equal(seg.mask, segment_depth(depth, CAMERA).mask)
 
 
+def test_footprint_contour_without_a_table_is_refused():
+    depth, _, _, _ = render(tilt_deg=12.7)
+    contour = segment_depth(depth, CAMERA).contour_px
+    noise = np.random.default_rng(0).uniform(0.3, 1.4, (H, W))
+    with pytest.warns(PerceptionWarning, match="no table plane"), pytest.raises(InputError, match="needs the table plane"):
+        contour_to_metric(contour, noise, CAMERA, on_table=True)
+
+
+def test_a_wide_shadow_is_not_a_flat_part_because_lightness_counts_little():
+    # A shadow 40 px wide beside the object: the table's colour at 60 % brightness, CIELAB distance 84,
+    # 35 with lightness weighted 0.25.
+    depth, rgb, truth, _ = render()
+    rows, cols = np.nonzero(truth)
+    shadow = np.zeros_like(truth)
+    shadow[rows.min(): rows.max(), cols.max(): cols.max() + 40] = True
+    rgb[shadow & ~truth] = (TABLE_RGB * 0.6).astype(np.uint8)
+    assert segment(rgb, depth, CAMERA).method == "depth"
+    assert segment(rgb, depth, CAMERA, colour_options={"lightness_weight": 1.0}).method == "depth+rgb"
+
+
 def test_auto_finds_a_flat_object_of_another_colour():
     depth, rgb, _, _ = render(kind="none")
     flat = np.zeros((H, W), dtype=bool)
@@ -546,6 +566,9 @@ def test_bad_input_messages():
         (lambda: segment(rgb, depth, CAMERA, colour_options={"halo": 3}), "colour_options: unknown option 'halo'"),
         (lambda: add_flat_parts(rgb, segment_rgb(rgb)), "needs a depth segmentation"),
         (lambda: add_flat_parts(rgb, segment_depth(depth, CAMERA), colour_distance=0), "colour_distance must be positive"),
+        (lambda: add_flat_parts(rgb, segment_depth(depth, CAMERA), lightness_weight=2), r"lightness_weight must be in \[0, 1\]"),
+        (lambda: contour_to_metric(segment_depth(depth, CAMERA).contour_px, depth, CAMERA, depth_mode="plane",
+                                   on_table=True), "a footprint lies on the table"),
         (lambda: add_flat_parts(rgb[:10], segment_depth(depth, CAMERA)), "rgb image is 640x10 but mask is 640x480"),
     ]
     for call, message in cases:
