@@ -409,9 +409,7 @@ def backproject(depth, intrinsics: Intrinsics) -> np.ndarray:
     """
     d = as_depth(depth)
     intrinsics.check_shape(d.shape, "depth image")
-    z = np.where(np.isfinite(d), d, np.nan)
-    v, u = np.indices(d.shape, dtype=float)
-    return np.stack([(u - intrinsics.cx) * z / intrinsics.fx, (v - intrinsics.cy) * z / intrinsics.fy, z], axis=-1)
+    return _points(np.where(np.isfinite(d), d, np.nan), intrinsics, *np.indices(d.shape))
 
 
 def fill_depth_holes(depth, *, max_hole_px: int = MAX_HOLE_PX) -> tuple[np.ndarray, int]:
@@ -662,9 +660,9 @@ def fit_table_plane(
 
 
 def _points(depth, intrinsics, rows, cols) -> np.ndarray:
-    """(n, 3) float: camera-frame points of the pixels (rows, cols), as :func:`backproject` computes them."""
+    """(..., 3) float: camera-frame points of the pixels (rows, cols), index arrays of any one shape (eq 3.1-3.2)."""
     z = depth[rows, cols]
-    return np.column_stack([(cols - intrinsics.cx) * z / intrinsics.fx, (rows - intrinsics.cy) * z / intrinsics.fy, z])
+    return np.stack([(cols - intrinsics.cx) * z / intrinsics.fx, (rows - intrinsics.cy) * z / intrinsics.fy, z], axis=-1)
 
 
 def _heights(depth, intrinsics, plane) -> np.ndarray:
@@ -958,8 +956,7 @@ def add_flat_parts(
     if seg.plane is None or seg.plane.inliers.shape != seg.mask.shape:
         raise InputError("add_flat_parts needs a depth segmentation with its table plane")
     halo = _dilate(seg.mask, halo_px)
-    unlike = _unlike_table(image, seg.mask, halo & ~seg.mask, seg.plane.inliers, colour_distance, lightness_weight,
-                           halo_px)
+    unlike = _unlike_table(image, seg.mask, halo, seg.plane.inliers, colour_distance, lightness_weight, halo_px)
     _, labels, stats, _ = cv2.connectedComponentsWithStats((unlike & ~halo).astype(np.uint8), connectivity=8)
     large = stats[:, cv2.CC_STAT_AREA] >= min_area_px
     large[0] = False
@@ -975,10 +972,10 @@ def add_flat_parts(
 def _unlike_table(image, depth_mask, halo, table, colour_distance, lightness_weight, halo_px):
     """(H, W) bool: pixels of a colour unlike the table's, opened, connected to ``depth_mask`` (without it).
 
-    ``halo`` is the depth mask dilated by ``halo_px``, less the mask.
+    ``halo`` is the depth mask dilated by ``halo_px``.
     """
     lab = cv2.cvtColor(image, cv2.COLOR_RGB2LAB)
-    ring = _dilate(depth_mask, 4 * halo_px) & ~halo & ~depth_mask & table
+    ring = _dilate(depth_mask, 4 * halo_px) & ~halo & table
     if not ring.any():
         return np.zeros(depth_mask.shape, dtype=bool)
     # Squared distance per channel by table look-up, summed: 8-bit values less a median (a multiple
