@@ -12,17 +12,12 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from ..synthesis import Cost, GraspPlan
+from ..synthesis import GraspPlan
 
 
 def _pose(pose) -> dict:
     x, y, yaw = (float(v) for v in pose)
     return {"x": x, "y": y, "yaw": yaw}
-
-
-def _cost(cost: Cost) -> dict:
-    return {"total": cost.total, "curvature": cost.curvature, "ratio": cost.ratio, "miss": cost.miss,
-            "quality": cost.quality}
 
 
 def _xy(point) -> list[float]:
@@ -37,7 +32,7 @@ def plan_to_dict(plan: GraspPlan) -> dict:
         "contourgrasp_version": __version__,
         "hand": plan.hand.name,
         "pose": _pose(plan.pose),
-        "cost": _cost(plan.cost),
+        "cost": asdict(plan.cost),
         "curvature_mode": plan.curvature_mode,
         "fingers": [
             {
@@ -72,7 +67,7 @@ def plan_to_dict(plan: GraspPlan) -> dict:
         },
         "safeguards": asdict(plan.safeguards),
         "quality": asdict(plan.quality),
-        "alternatives": [{"pose": _pose(a.pose), "cost": _cost(a.cost)} for a in plan.alternatives],
+        "alternatives": [{"pose": _pose(a.pose), "cost": asdict(a.cost)} for a in plan.alternatives],
         "refinement": None if plan.refinement is None else {
             "grid_pose": _pose(plan.refinement.grid_pose), "grid_cost": plan.refinement.grid_cost,
             "cost": plan.refinement.cost, "gain": plan.refinement.gain},
