@@ -5,7 +5,8 @@ Every frame of ``<data>/rgbd/*/`` that has ``color_N.png``, ``depth_N.npy`` and
 method of :func:`contourgrasp.perception.segment`; the script prints a
 Markdown table of the IoU per frame, the mean, the worst frame and the time
 per frame. A refused frame (SegmentationError) scores IoU 0; a note in brackets
-says which method ``auto`` used (``depth``, ``depth+rgb`` or ``rgb``).
+says which method ``auto`` used (``depth``, ``depth+rgb`` or ``rgb``) and by how much
+it shifted the colour image onto the depth image (``Segmentation.colour_offset_px``).
 
 Usage::
 
@@ -69,7 +70,10 @@ def run(rgb, depth, intrinsics, truth, method, repeat):
     if result is None:
         return 0.0, note, best
     iou = float((result.mask & truth).sum() / (result.mask | truth).sum())
-    return iou, "" if result.method == method else f"used {result.method}", best
+    notes = [] if result.method == method else [f"used {result.method}"]
+    if result.colour_offset_px is not None:
+        notes.append("colour shifted ({}, {}) px".format(*result.colour_offset_px))
+    return iou, ", ".join(notes), best
 
 
 def main(argv=None) -> int:

@@ -26,3 +26,25 @@ def test_harmonics_figure_has_one_panel_per_count(tmp_path):
     assert [ax.get_title() for ax in fig.axes] == ["1 harmonic", "4 harmonics", "8 harmonics"]
     fig.savefig(tmp_path / "h.png")
     assert (tmp_path / "h.png").stat().st_size > 1000
+
+
+def test_image_plan_is_drawn_where_the_colour_image_shows_the_object():
+    # Segmentation works in depth pixels; over the colour image everything is drawn less the colour offset.
+    from dataclasses import replace
+    from pathlib import Path
+
+    from contourgrasp.io.camera_file import read_rgbd
+
+    folder = Path(__file__).resolve().parents[1] / "examples" / "bar_clamp"
+    frame = read_rgbd(folder / "color_0.png", folder / "depth_0.npy", folder / "primesense_overhead_color.intr")
+    result = cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, "three-finger", xy_step=0.03,
+                           yaw_step=math.radians(6))
+    result = replace(result, segmentation=replace(result.segmentation, colour_offset_px=(3, -2)))
+    contour = result.segmentation.contour_px
+    for rgb, shift in ((frame.rgb, (3, -2)), (None, (0, 0))):
+        ax = visualize.image_plan_figure(result, rgb).axes[0]
+        outline = ax.lines[0].get_xydata()
+        np.testing.assert_allclose(outline[:-1], contour - shift)
+        starts = [line.get_xydata()[0] for line in ax.lines if line.get_marker() == "o"]
+        expected = visualize._to_pixels(result, [f.start for f in result.plan.fingers]) - shift
+        np.testing.assert_allclose(starts, expected)

@@ -107,34 +107,37 @@ def harmonics_figure(contour_xy, harmonics: Sequence[int] = (1, 2, 4, 8), *, cur
     return fig
 
 
-def _to_pixels(result, points_xy) -> np.ndarray:
-    """(n, 2) float: pixels of planning-frame points (n, 2) in the contour's plane."""
-    return result.camera.project(result.metric.to_camera(points_xy))
+def _to_pixels(result, points_xy, shift=(0, 0)) -> np.ndarray:
+    """(n, 2) float: pixels of planning-frame points (n, 2) in the contour's plane, less ``shift``."""
+    return result.camera.project(result.metric.to_camera(points_xy)) - shift
 
 
 def image_plan_figure(result, rgb=None) -> Figure:
     """An RGB-D plan: the image with contour, hand and grasp points (left) beside the metric plan (right).
 
     ``result`` is a :class:`contourgrasp.pipeline.ImageGraspPlan`; ``rgb`` the
-    colour image (the depth-derived mask is shown when it is None).
+    colour image (the depth-derived mask is shown when it is None). Over a
+    colour image that segmentation registered to the depth image, everything
+    is drawn less the colour offset, so that it lines up with the colour.
     """
     plan = result.plan
     fig = Figure(figsize=(16, 7), layout="constrained")
     image_ax, plan_ax = fig.subplots(1, 2, width_ratios=[1.2, 1])
     seg = result.segmentation
     image_ax.imshow(rgb if rgb is not None else seg.mask, cmap="gray")
-    contour = np.vstack([seg.contour_px, seg.contour_px[:1]])
+    shift = np.asarray(seg.colour_offset_px if rgb is not None and seg.colour_offset_px is not None else (0, 0))
+    contour = np.vstack([seg.contour_px, seg.contour_px[:1]]) - shift
     outline = "footprint on the table" if seg.on_table else "contour"
     image_ax.plot(*contour.T, color="yellow", lw=1.2, label=f"{outline} ({seg.method})")
     for i, (finger, contact) in enumerate(zip(plan.hand.fingers, plan.fingers)):
         colour = FINGER_COLOURS[i % len(FINGER_COLOURS)]
-        path = _to_pixels(result, to_image(finger.points(np.linspace(0, finger.travel, 30)), plan.pose))
+        path = _to_pixels(result, to_image(finger.points(np.linspace(0, finger.travel, 30)), plan.pose), shift)
         image_ax.plot(*path.T, color=colour, lw=1.5, ls="--" if contact.missed else "-")
-        image_ax.plot(*_to_pixels(result, [contact.start])[0], "o", color=colour, mfc="white")
-        grasp = _to_pixels(result, [contact.grasp_point])[0]
+        image_ax.plot(*_to_pixels(result, [contact.start], shift)[0], "o", color=colour, mfc="white")
+        grasp = _to_pixels(result, [contact.grasp_point], shift)[0]
         image_ax.plot(*grasp, "X" if contact.missed else "*", color=colour, ms=12, mec="black", mew=0.6)
         image_ax.annotate(finger.name, grasp, textcoords="offset points", xytext=(6, 6), color=colour, fontsize=9)
-    pixels = np.vstack([contour, _to_pixels(result, [f.start for f in plan.fingers])])
+    pixels = np.vstack([contour, _to_pixels(result, [f.start for f in plan.fingers], shift)])
     lo, hi = pixels.min(axis=0) - 40, pixels.max(axis=0) + 40
     image_ax.set_xlim(max(lo[0], 0), min(hi[0], result.camera.width))
     image_ax.set_ylim(min(hi[1], result.camera.height), max(lo[1], 0))

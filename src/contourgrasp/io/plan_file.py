@@ -86,6 +86,7 @@ def image_plan_to_dict(result) -> dict:
         "contour_px": np.asarray(seg.contour_px).tolist(),
         "invalid_depth_px": metric.invalid_depth_px,
         "filled_depth_px": result.filled_depth_px,
+        "colour_offset_px": None if seg.colour_offset_px is None else list(seg.colour_offset_px),
         "warnings": list(seg.warnings),
     }
     data["planning_frame"] = {
