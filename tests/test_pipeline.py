@@ -104,6 +104,18 @@ def test_plan_json_has_the_pose_fields(tmp_path, capsys):
     assert (tmp_path / "p.png").stat().st_size > 10000
 
 
+def test_plan_reports_and_takes_the_colour_offset(tmp_path):
+    # The bundled frame's colour lies 2 px below its depth; --colour-offset overrides the estimate.
+    args = ["plan", "--rgb", str(FRAME / "color_0.png"), "--depth", str(FRAME / "depth_0.npy"),
+            "--intrinsics", str(FRAME / "primesense_overhead_color.intr"), "--xy-step", "0.03", "--yaw-step-deg", "6"]
+    for extra, expected in (([], [0, -2]), (["--colour-offset", "1,-3"], [1, -3])):
+        assert main([*args, *extra, "--out", str(tmp_path / "p.json")]) == 0
+        assert json.loads((tmp_path / "p.json").read_text())["segmentation"]["colour_offset_px"] == expected
+    with pytest.raises(SystemExit) as exit_:
+        main([*args, "--colour-offset", "1.5,0"])
+    assert exit_.value.code == 2
+
+
 def write(path, text):
     path.write_text(text)
     return path

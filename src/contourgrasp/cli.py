@@ -90,6 +90,9 @@ def _parser() -> argparse.ArgumentParser:
                       help="contour plane: 'max' (thesis eq 3.1-3.2; the footprint on the table when the camera is "
                            "tilted) or the object's top 'plane' (default: the planner's)")
     plan.add_argument("--no-fill-holes", action="store_true", help="do not fill small depth holes")
+    plan.add_argument("--colour-offset", type=_pixel_pair, metavar="DX,DY",
+                      help="colour-depth misregistration in pixels, 0,0 for a pair registered to the pixel "
+                           "(default: estimated from the object's edges)")
     plan.add_argument("--approach-offset", type=float, default=0.01, help="added to the nearest depth, m")
     plan.add_argument("--standoff", type=_non_negative_float, default=0.10, help="pre-grasp distance, m")
     plan.add_argument("--extrinsics", help="T_base_camera (4x4): .npy, .txt, .json, .yaml or autolab .tf")
@@ -104,6 +107,14 @@ def _parser() -> argparse.ArgumentParser:
     harm.add_argument("--curvature", choices=efd.CURVATURE_MODES, default="paper")
     harm.add_argument("--plot", help="write the figure (PNG) here")
     return parser
+
+
+def _pixel_pair(text: str) -> tuple[int, int]:
+    try:
+        dx, dy = (int(part) for part in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be two integers DX,DY, got {text}") from None
+    return dx, dy
 
 
 def _harmonics(text: str):
@@ -242,6 +253,7 @@ def _plan(args) -> int:
         segment=args.segment,
         mask=None if args.mask is None else read_mask(args.mask),
         fill_holes=not args.no_fill_holes,
+        colour_offset_px=args.colour_offset,
         approach_offset=args.approach_offset,
         standoff=args.standoff,
         T_base_camera=None if args.extrinsics is None else read_extrinsics(args.extrinsics),

@@ -79,6 +79,7 @@ def plan_grasp(
     mask=None,
     depth_mode: str = "max",
     fill_holes: bool = True,
+    colour_offset_px=None,
     approach_offset: float = perception.APPROACH_OFFSET,
     standoff: float = 0.10,
     T_base_camera=None,
@@ -104,6 +105,10 @@ def plan_grasp(
         itself; with ``"plane"`` always the pixels that see the object, planned at the object's top.
     fill_holes : bool
         Fill small depth holes (nearest valid reading) before use.
+    colour_offset_px : (int, int), optional
+        The colour-depth misregistration (dx, dy) if known, ``(0, 0)`` for a pair registered to the
+        pixel; by default ``"auto"`` segmentation estimates it
+        (:func:`contourgrasp.perception.colour_offset`).
     approach_offset : float
         Added to the nearest depth inside the contour, m.
     standoff : float
@@ -123,7 +128,8 @@ def plan_grasp(
     if not (math.isfinite(standoff) and standoff >= 0):
         raise InputError(f"standoff must be a distance >= 0, got {standoff}")
     seg, metric, filled = perceive(rgb, depth, intrinsics, segment=segment, mask=mask, depth_mode=depth_mode,
-                                   fill_holes=fill_holes, approach_offset=approach_offset)
+                                   fill_holes=fill_holes, colour_offset_px=colour_offset_px,
+                                   approach_offset=approach_offset)
     plan = synthesize(metric.contour_xy, hand, **synthesis_options)
     T_camera_hand = hand_pose(metric, plan.pose, metric.approach_depth)
     T_camera_pregrasp = T_camera_hand.copy()
@@ -141,6 +147,7 @@ def perceive(
     mask=None,
     depth_mode: str = "max",
     fill_holes: bool = True,
+    colour_offset_px=None,
     approach_offset: float = perception.APPROACH_OFFSET,
 ) -> tuple[Segmentation, MetricContour, int]:
     """The perception half of :func:`plan_grasp`: (segmentation, metric contour, filled depth pixels).
@@ -161,7 +168,7 @@ def perceive(
         intrinsics.check_shape(np.shape(mask), "mask")
         seg = perception.segment_from_mask(mask)
     else:
-        seg = perception.segment(rgb, d, intrinsics, method=segment,
+        seg = perception.segment(rgb, d, intrinsics, method=segment, colour_offset_px=colour_offset_px,
                                  depth_options={"footprint": False} if depth_mode == "plane" else None)
     metric = perception.contour_to_metric(
         seg.contour_px, d, intrinsics, depth_mode=depth_mode, plane=seg.plane, on_table=seg.on_table,
