@@ -137,7 +137,7 @@ LIGHTNESS_WEIGHT = 0.25
 HALO_PX = 8
 
 #: Largest colour-depth misregistration searched for, pixels in each direction.
-MAX_COLOUR_OFFSET_PX = 6
+MAX_COLOUR_OFFSET_PX = 8
 
 #: The colour-depth registration compares edges over the object's bounding box grown by this, pixels.
 REGISTRATION_MARGIN_PX = 20
@@ -1192,6 +1192,7 @@ def segment(
     rgb_options = _check_options("rgb_options", rgb_options, segment_rgb)
     depth_options = _check_options("depth_options", depth_options, segment_depth)
     colour_options = _check_options("colour_options", colour_options, add_flat_parts)
+    offset = None if colour_offset_px is None else _check_offset(colour_offset_px)
     if depth is not None and intrinsics is None:
         raise InputError("a depth image needs intrinsics")
     have_depth = depth is not None
@@ -1205,7 +1206,6 @@ def segment(
         raise InputError("method 'depth' needs a depth image and intrinsics")
     if method == "depth" or rgb is None:
         return segment_depth(depth, intrinsics, **depth_options)
-    offset = None if colour_offset_px is None else _check_offset(colour_offset_px)
     seen_options = {**_defaults(segment_depth), **depth_options}
     footprint = seen_options.pop("footprint")
     try:
@@ -1617,7 +1617,7 @@ def _check_options(name, options, function) -> dict:
         return {}
     if not isinstance(options, dict):
         raise InputError(f"{name} must be a dict of keyword options, got {type(options).__name__}")
-    allowed = [p.name for p in signature(function).parameters.values() if p.kind is Parameter.KEYWORD_ONLY]
+    allowed = list(_defaults(function))
     unknown = sorted(set(options) - set(allowed))
     if unknown:
         raise InputError(f"{name}: unknown option {unknown[0]!r}; choose from {', '.join(allowed)}")
