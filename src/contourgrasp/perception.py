@@ -61,7 +61,8 @@ Readings of ours (where the thesis is silent)
   touches the border is refused, not handed to RGB.
 * Colour-depth registration. The shared PrimeSense pairs are sold as
   registered, but an object's outline in depth lies 1-6 px above its outline
-  in colour (dx 0-1 px). So ``"auto"`` first finds that shift where the
+  in colour (dx 0-1 px; 2 px on the raw bar-clamp frame; on the others part
+  of it may be the authors' fill of the depth around the object). So ``"auto"`` first finds that shift where the
   object is (:func:`colour_offset`, edge correlation) and moves the colour
   image onto the depth image (:func:`register_colour`) before it looks for
   flat parts; masks and contours are in depth pixels (the shift is in
@@ -1255,10 +1256,11 @@ def segment_from_mask(mask, *, min_area_px: int = MIN_AREA_PX) -> Segmentation:
 
 def _pick_object(candidates, outside, min_area_px, where):
     """The largest candidate region touching neither the image border nor ``outside``, holes filled; the warnings."""
-    labels, count = ndimage.label(candidates, structure=np.ones((3, 3)))
+    count, labels, stats, _ = cv2.connectedComponentsWithStats(candidates.astype(np.uint8), connectivity=8)
+    count -= 1
     if count == 0:
         raise SegmentationError("no-object", f"no object found: no region {where}")
-    areas = np.bincount(labels.ravel())
+    areas = stats[:, cv2.CC_STAT_AREA]
     beyond = np.pad(outside, 1, constant_values=True).astype(np.uint8)
     near = cv2.dilate(beyond, np.ones((3, 3), np.uint8))[1:-1, 1:-1] > 0
     touching = np.zeros(count + 1, dtype=bool)
