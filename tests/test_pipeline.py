@@ -104,13 +104,29 @@ def test_plan_json_has_the_pose_fields(tmp_path, capsys):
     assert (tmp_path / "p.png").stat().st_size > 10000
 
 
-def test_plan_reports_and_takes_the_colour_offset(tmp_path):
+def test_footprint_can_be_forced_either_way():
+    # The bundled frame is tilted 3.3 deg, so by default the footprint is planned, on the table plane.
+    frame = bundled()
+    default = cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, "three-finger", **FAST)
+    seen = cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, "three-finger", footprint=False, **FAST)
+    assert default.segmentation.on_table and default.metric.on_table
+    assert not seen.segmentation.on_table and not seen.metric.on_table
+    assert seen.segmentation.area_px > default.segmentation.area_px  # the tall clamp's top and near side
+    with pytest.raises(cg.InputError, match="footprint=True needs depth_mode 'max'"):
+        cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, "three-finger", footprint=True, depth_mode="plane")
+    with pytest.raises(cg.InputError, match="footprint must be True, False or None"):
+        cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, "three-finger", footprint="yes")
+
+
+def test_plan_takes_the_colour_offset_and_footprint_options(tmp_path):
     # The bundled frame's colour lies 2 px below its depth; --colour-offset overrides the estimate.
     args = ["plan", "--rgb", str(FRAME / "color_0.png"), "--depth", str(FRAME / "depth_0.npy"),
             "--intrinsics", str(FRAME / "primesense_overhead_color.intr"), "--xy-step", "0.03", "--yaw-step-deg", "6"]
     for extra, expected in (([], [0, -2]), (["--colour-offset", "1,-3"], [1, -3])):
         assert main([*args, *extra, "--out", str(tmp_path / "p.json")]) == 0
         assert json.loads((tmp_path / "p.json").read_text())["segmentation"]["colour_offset_px"] == expected
+    assert main([*args, "--no-footprint", "--out", str(tmp_path / "p.json")]) == 0
+    assert json.loads((tmp_path / "p.json").read_text())["planning_frame"]["on_table"] is False
     with pytest.raises(SystemExit) as exit_:
         main([*args, "--colour-offset", "1.5,0"])
     assert exit_.value.code == 2

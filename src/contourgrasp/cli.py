@@ -89,6 +89,9 @@ def _parser() -> argparse.ArgumentParser:
     plan.add_argument("--depth-mode", choices=("max", "plane"),
                       help="contour plane: 'max' (thesis eq 3.1-3.2; the footprint on the table when the camera is "
                            "tilted) or the object's top 'plane' (default: the planner's)")
+    plan.add_argument("--footprint", action=argparse.BooleanOptionalAction,
+                      help="plan the object's footprint on the table even from a top-down camera, or never "
+                           "(default: the planner's; without one, when the camera is tilted more than 2 deg)")
     plan.add_argument("--no-fill-holes", action="store_true", help="do not fill small depth holes")
     plan.add_argument("--colour-offset", type=_pixel_pair, metavar="DX,DY",
                       help="colour-depth misregistration in pixels, 0,0 for a pair registered to the pixel "
@@ -194,6 +197,7 @@ def _plan_options(args) -> dict:
         "require_closure": args.require_closure,
         "quality_gain": args.quality_gain,
         "depth_mode": getattr(args, "depth_mode", None),
+        "footprint": getattr(args, "footprint", None),
         "top_k": args.top_k,
         "refine": args.refine,
     }

@@ -792,9 +792,9 @@ def segment_depth(
     top-down camera keeps the thesis's reading, the region seen, which eq
     3.1-3.2 then measure at the table's depth (the outline overstated by
     height / depth); the footprint would measure it exactly, but on the
-    simulated top-down bench (``make bench``) it lowered the default planner
-    from 96 % to 89 % and the thesis's from 43 % to 33 %, so it is an option
-    there.
+    simulated top-down bench it lowered the default planner from 96 % to 89 %
+    and the thesis's from 43 % to 33 % (README, "Perception"), so it is an
+    option there (``plan_grasp(footprint=True)``).
 
     An object, or a part of one, lower than ``min_height`` is invisible to this
     method: the flat metal head of the shared can opener (frame 6) is, and only

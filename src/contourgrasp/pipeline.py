@@ -78,6 +78,7 @@ def plan_grasp(
     segment: str = "auto",
     mask=None,
     depth_mode: str = "max",
+    footprint: bool | None = None,
     fill_holes: bool = True,
     colour_offset_px=None,
     approach_offset: float = perception.APPROACH_OFFSET,
@@ -103,6 +104,10 @@ def plan_grasp(
         Height of the contour's plane (:func:`contourgrasp.perception.contour_to_metric`). With ``"max"``
         depth segmentation returns the object's footprint when the camera is tilted, planned on the table
         itself; with ``"plane"`` always the pixels that see the object, planned at the object's top.
+    footprint : bool, optional
+        With ``depth_mode="max"``: plan the object's footprint on the table
+        (:func:`contourgrasp.perception.object_footprint`) even from a top-down camera (True), or
+        never (False); by default only when the camera is tilted more than 2 deg.
     fill_holes : bool
         Fill small depth holes (nearest valid reading) before use.
     colour_offset_px : (int, int), optional
@@ -128,7 +133,7 @@ def plan_grasp(
     if not (math.isfinite(standoff) and standoff >= 0):
         raise InputError(f"standoff must be a distance >= 0, got {standoff}")
     seg, metric, filled = perceive(rgb, depth, intrinsics, segment=segment, mask=mask, depth_mode=depth_mode,
-                                   fill_holes=fill_holes, colour_offset_px=colour_offset_px,
+                                   footprint=footprint, fill_holes=fill_holes, colour_offset_px=colour_offset_px,
                                    approach_offset=approach_offset)
     plan = synthesize(metric.contour_xy, hand, **synthesis_options)
     T_camera_hand = hand_pose(metric, plan.pose, metric.approach_depth)
@@ -146,6 +151,7 @@ def perceive(
     segment: str = "auto",
     mask=None,
     depth_mode: str = "max",
+    footprint: bool | None = None,
     fill_holes: bool = True,
     colour_offset_px=None,
     approach_offset: float = perception.APPROACH_OFFSET,
@@ -157,6 +163,10 @@ def perceive(
     """
     if segment not in SEGMENT_CHOICES:
         raise InputError(f"segment must be one of {SEGMENT_CHOICES}, got {segment!r}")
+    if footprint not in (None, True, False):
+        raise InputError(f"footprint must be True, False or None, got {footprint!r}")
+    if footprint and depth_mode == "plane":
+        raise InputError("footprint=True needs depth_mode 'max': a footprint lies on the table, not at the object's top")
     d = perception.as_depth(depth)
     intrinsics.check_shape(d.shape, "depth image")
     if not perception.valid_depth(d).any():
@@ -169,7 +179,7 @@ def perceive(
         seg = perception.segment_from_mask(mask)
     else:
         seg = perception.segment(rgb, d, intrinsics, method=segment, colour_offset_px=colour_offset_px,
-                                 depth_options={"footprint": False} if depth_mode == "plane" else None)
+                                 depth_options={"footprint": False if depth_mode == "plane" else footprint})
     metric = perception.contour_to_metric(
         seg.contour_px, d, intrinsics, depth_mode=depth_mode, plane=seg.plane, on_table=seg.on_table,
         offset=approach_offset,

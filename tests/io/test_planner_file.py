@@ -25,18 +25,20 @@ def test_preset_options_are_accepted_by_synthesis(name):
 
 def test_a_file_round_trips_its_options(tmp_path):
     path = tmp_path / "mine.toml"
-    path.write_text('name = "mine"\nharmonics = "adaptive"\nd_max = [0.1, 0.12]\nfinger_thickness = true\n'
-                    'clearance = 0.005\n')
+    path.write_text('name = "mine"\nharmonics = "adaptive"\nd_max = [0.1, 0.12]\nfootprint = true\n'
+                    'finger_thickness = true\nclearance = 0.005\n')
     planner = load_planner(str(path))
     assert planner.name == "mine"
-    assert planner.plan_options == {"harmonics": "adaptive", "d_max": (0.1, 0.12), "finger_thickness": True,
-                                    "clearance": 0.005}
+    assert planner.plan_options == {"harmonics": "adaptive", "d_max": (0.1, 0.12), "footprint": True,
+                                    "finger_thickness": True, "clearance": 0.005}
+    assert "footprint" not in planner.synthesis_options
 
 
 @pytest.mark.parametrize("text, field", [
     ('name = "x"\nxy_step = -0.01', "xy_step"),
     ('name = "x"\nharmonics = "many"', "harmonics"),
     ('name = "x"\ncurvature = "wiggly"', "curvature"),
+    ('name = "x"\nfootprint = "yes"', "footprint"),
     ('name = "x"\nspeed = 3', "speed"),
     ('harmonics = 4', "name"),
     ('name = "x"\nfinger_thickness = 1', "finger_thickness"),

@@ -16,6 +16,8 @@ which is the thesis's setting)::
     d_max = 0.15                 # or [x, y], m (Table 4.2)
     d_min = 0.015                # m (Table 4.2)
     depth_mode = "max"           # or "plane" (perception.contour_to_metric)
+    footprint = true             # plan the object's footprint (perception.object_footprint); absent:
+                                 # only when the camera is tilted more than 2 deg
     refine = false               # continuous refinement of the best grid poses
     finger_thickness = false     # synthesis.Safeguards ...
     clearance = 0.0              # m
@@ -39,7 +41,7 @@ from . import _toml_files
 
 _PRESET_DIR = "data/planners"
 #: Options that belong to perception (the rest are :func:`contourgrasp.synthesis.synthesize`'s).
-PERCEPTION_OPTIONS = ("depth_mode",)
+PERCEPTION_OPTIONS = ("depth_mode", "footprint")
 
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
@@ -61,6 +63,7 @@ class _PlannerSchema(BaseModel):
     d_max: NonNegative | Annotated[list[NonNegative], Field(min_length=2, max_length=2)] | None = None
     d_min: NonNegative | None = None
     depth_mode: Literal["max", "plane"] | None = None
+    footprint: bool | None = None
     refine: bool | None = None
     finger_thickness: bool | None = None
     clearance: NonNegative | None = None
