@@ -1,9 +1,12 @@
 import math
+from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 
 import contourgrasp as cg
 from contourgrasp import visualize
+from contourgrasp.io.camera_file import read_rgbd
 
 
 def test_plan_figure_draws_every_finger_and_the_cost():
@@ -30,11 +33,6 @@ def test_harmonics_figure_has_one_panel_per_count(tmp_path):
 
 def test_image_plan_is_drawn_where_the_colour_image_shows_the_object():
     # Segmentation works in depth pixels; over the colour image everything is drawn less the colour offset.
-    from dataclasses import replace
-    from pathlib import Path
-
-    from contourgrasp.io.camera_file import read_rgbd
-
     folder = Path(__file__).resolve().parents[1] / "examples" / "bar_clamp"
     frame = read_rgbd(folder / "color_0.png", folder / "depth_0.npy", folder / "primesense_overhead_color.intr")
     result = cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, "three-finger", xy_step=0.03,
