@@ -1,12 +1,16 @@
-"""Scene and rendering: geometry of the top-down camera, noise, plan_grasp on a rendered can."""
+"""Scene and rendering: geometry of the top-down and tilted cameras, noise, exact masks, plan_grasp on a rendered can."""
 
 import numpy as np
 import pytest
 
 import contourgrasp
-from contourgrasp.sim import Camera, DepthNoise, build_scene, hand_pose_from_matrix, render, render_view
-from contourgrasp.sim.planners import make_planner
-from contourgrasp.sim.scene import Workspace
+from contourgrasp import perception
+from contourgrasp.sim import (Camera, DepthNoise, build_scene, hand_pose_from_matrix, object_truth, render,
+                              render_view, tilted_view)
+from contourgrasp.sim.planners import camera_intrinsics, make_planner
+from contourgrasp.sim.scene import R_WORLD_CAMERA, Workspace
+
+TILT = np.radians(12.7)
 
 
 @pytest.fixture(scope="module")
@@ -78,3 +82,44 @@ def test_planner_finds_the_can(can_scene):
     can_centre = can_scene.camera.from_world(can_scene.object_com())[:2]
     assert np.linalg.norm(grasp_centre - can_centre) < 0.04
     assert abs(approach - (can_scene.camera.height - 0.066 + 0.01)) < 0.005
+
+
+def test_tilted_view_geometry():
+    eye, R = tilted_view(0.0, 0.65)
+    np.testing.assert_allclose(eye, [0.0, 0.0, 0.65])
+    np.testing.assert_allclose(R, R_WORLD_CAMERA)
+    eye, R = tilted_view(TILT, 0.7, target=(0.1, 0.0, 0.0))
+    np.testing.assert_allclose(R.T @ R, np.eye(3), atol=1e-12)
+    assert np.isclose(np.linalg.det(R), 1.0)
+    np.testing.assert_allclose(eye + 0.7 * R[:, 2], [0.1, 0.0, 0.0], atol=1e-12)  # looks at the target
+    assert np.isclose(np.arccos(-R[2, 2]), TILT)  # optical axis 12.7 deg from straight down
+    np.testing.assert_allclose(R.T @ [0.0, 0.0, 1.0], [0.0, -0.220, -0.976], atol=1e-3)  # the PrimeSense frames' normal
+
+
+def test_object_truth_from_above(can_scene):
+    _, depth = render(can_scene)
+    seen, footprint = object_truth(can_scene)
+    np.testing.assert_array_equal(seen, (depth > 0) & (depth < can_scene.camera.height - 1e-4))
+    # Straight down, a lying can's footprint is its 0.066 x 0.120 m rectangle at the table's depth.
+    intr = can_scene.camera.intrinsics
+    expected = 0.066 * 0.120 * intr.fx * intr.fy / can_scene.camera.height**2
+    assert abs(footprint.sum() / expected - 1) < 0.02
+    centre = can_scene.camera.from_world(can_scene.object_com() * [1.0, 1.0, 0.0])  # on the table, below the axis
+    centre_px = intr.matrix @ (centre / centre[2])
+    rows, cols = np.nonzero(footprint)
+    assert np.hypot(cols.mean() - centre_px[0], rows.mean() - centre_px[1]) < 1.0
+
+
+def test_footprint_segmentation_matches_the_exact_footprint_of_a_tilted_view():
+    scene = build_scene("can", seed=0, camera=Camera(height=0.7))
+    view = tilted_view(TILT, 0.7)
+    rgb, depth = render(scene, noise=True, seed=0, view=view)
+    seen, footprint = object_truth(scene, view)
+    result = perception.segment(rgb, depth, camera_intrinsics(scene.camera.intrinsics))
+    assert np.isclose(result.plane.tilt, TILT, atol=np.radians(0.5)) and result.on_table
+
+    def iou(truth):
+        return (result.mask & truth).sum() / (result.mask | truth).sum()
+
+    assert iou(footprint) > 0.9
+    assert iou(seen) < iou(footprint) - 0.1  # the footprint, not the region seen

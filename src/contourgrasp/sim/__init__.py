@@ -22,7 +22,7 @@ Example::
 from .hand_model import TIMINGS, FingerTiming, HandDesign, HandModel, build_hand
 from .measure import fingertip_path_error, fingertip_paths
 from .objects import THESIS_OBJECTS, ObjectSpec, Part, mesh_object, object_spec
-from .render import DepthNoise, render, render_view
+from .render import DepthNoise, object_truth, render, render_view, tilted_view
 from .scene import Camera, Intrinsics, Placement, Scene, Workspace, build_scene
 from .trial import (DROPPED, FAILURE_CAUSES, NO_PLAN, PUSHED, SLIPPED, STRUCK, Execution, GraspOutcome, TrialRecord,
                     execute_grasp, hand_pose_from_matrix, pose_matrix, run_trial, scripted_grasp)
@@ -31,6 +31,6 @@ __all__ = [
     "Camera", "DROPPED", "DepthNoise", "Execution", "FAILURE_CAUSES", "FingerTiming", "GraspOutcome", "HandDesign",
     "HandModel", "Intrinsics", "NO_PLAN", "ObjectSpec", "PUSHED", "Part", "Placement", "SLIPPED", "STRUCK", "Scene",
     "THESIS_OBJECTS", "TIMINGS", "TrialRecord", "Workspace", "build_hand", "build_scene", "execute_grasp",
-    "fingertip_path_error", "fingertip_paths", "hand_pose_from_matrix", "mesh_object", "object_spec", "pose_matrix",
-    "render", "render_view", "run_trial", "scripted_grasp",
+    "fingertip_path_error", "fingertip_paths", "hand_pose_from_matrix", "mesh_object", "object_spec", "object_truth",
+    "pose_matrix", "render", "render_view", "run_trial", "scripted_grasp", "tilted_view",
 ]

@@ -1,4 +1,4 @@
-"""RGB-D images of a scene by ray casting (no OpenGL needed): the camera's picture, and views for figures.
+"""RGB-D images of a scene by ray casting (no OpenGL needed): the camera's picture, views for figures, exact masks.
 
 One ray per pixel centre leaves the optical centre (``mujoco.mj_multiRay``);
 the hit distance along a ray whose camera-frame direction has unit z is the
@@ -10,6 +10,11 @@ SR300: Gaussian noise growing with the square of the depth (~1.7 mm at
 0.65 m), readings missing at random along depth discontinuities (the projector
 and the camera do not see the same side of an edge), and nothing outside the
 sensor's range.
+
+:func:`object_truth` gives the exact segmentation of a picture, for judging
+perception against it: the pixels that see the object, and the pixels that see
+the table where the object stands (its footprint). :func:`tilted_view` places
+a camera that is not top-down, like the PrimeSense of the shared real frames.
 """
 
 from __future__ import annotations
@@ -49,8 +54,8 @@ class DepthNoise:
 
 
 def render(scene: Scene, *, noise: DepthNoise | bool = False, seed: int = 0,
-           show_hand: bool = False) -> tuple[np.ndarray, np.ndarray]:
-    """Render the scene from its camera.
+           show_hand: bool = False, view=None) -> tuple[np.ndarray, np.ndarray]:
+    """Render the scene from its camera (or from ``view``, with the camera's intrinsics).
 
     Parameters
     ----------
@@ -61,6 +66,9 @@ def render(scene: Scene, *, noise: DepthNoise | bool = False, seed: int = 0,
         Seeds the noise.
     show_hand : bool
         Draw the hand too (for figures; the planner's picture is taken without it).
+    view : (eye, R_world_camera), optional
+        The optical centre (3,) and the optical frame's rotation (3, 3), world
+        frame (e.g. from :func:`tilted_view`); default: the scene's top-down camera.
 
     Returns
     -------
@@ -69,7 +77,8 @@ def render(scene: Scene, *, noise: DepthNoise | bool = False, seed: int = 0,
         Meters along the optical axis; 0 where nothing is hit or out of range.
     """
     intr = scene.camera.intrinsics
-    rgb, depth = _cast(scene, scene.camera.position, R_WORLD_CAMERA, intr, show_hand, 2 * intr.depth_max)
+    eye, R_world_camera = _view(scene, view)
+    rgb, depth, _ = _cast(scene, eye, R_world_camera, intr, show_hand, 2 * intr.depth_max)
     if noise:
         depth = _noisy(depth, DepthNoise() if noise is True else noise, np.random.default_rng([seed, 1]))
     depth = np.where((depth >= intr.depth_min) & (depth <= intr.depth_max), depth, 0.0)
@@ -99,25 +108,90 @@ def render_view(scene: Scene, eye, target, intrinsics: Intrinsics = VIEW_INTRINS
     right = np.cross(forward, [0.0, 0.0, 1.0])
     right /= np.linalg.norm(right)
     rotation = np.column_stack([right, np.cross(forward, right), forward])  # optical frame: x right, y down
-    rgb, depth = _cast(scene, eye, rotation, intrinsics, show_hand, VIEW_RANGE)
+    rgb, depth, _ = _cast(scene, eye, rotation, intrinsics, show_hand, VIEW_RANGE)
     return rgb, depth > 0
 
 
+def tilted_view(tilt: float, distance: float, target=(0.0, 0.0, 0.0)) -> tuple[np.ndarray, np.ndarray]:
+    """A camera ``distance`` m from ``target`` looking at it, tilted ``tilt`` rad from looking straight down.
+
+    The camera leans back along world -y, so the image's top sees farther
+    than its bottom and the table's normal has a negative y in the optical
+    frame, as in the shared PrimeSense frames (12.7 deg at about 0.7 m).
+
+    Returns
+    -------
+    eye : (3,) float
+        Optical centre, world frame.
+    R_world_camera : (3, 3) float
+        Optical frame (x right, y down, z forward) in the world frame.
+    """
+    c, s = np.cos(tilt), np.sin(tilt)
+    R_world_camera = np.array([[1.0, 0.0, 0.0], [0.0, -c, s], [0.0, -s, -c]])
+    return np.asarray(target, dtype=float) - distance * R_world_camera[:, 2], R_world_camera
+
+
+def object_truth(scene: Scene, view=None) -> tuple[np.ndarray, np.ndarray]:
+    """The exact segmentation of :func:`render`'s picture (same ``view``), hand never shown.
+
+    Returns
+    -------
+    seen : (H, W) bool
+        Pixels whose ray meets the object first.
+    footprint : (H, W) bool
+        Pixels whose ray meets the table top (z = 0) at a point under the
+        object: a vertical ray down through that point meets the object
+        before the table. Seen from straight above this is the object's
+        outline; from a tilted camera it is where the object stands, which
+        :func:`contourgrasp.perception.object_footprint` estimates.
+    """
+    intr = scene.camera.intrinsics
+    eye, R_world_camera = _view(scene, view)
+    _, _, geom = _cast(scene, eye, R_world_camera, intr, False, VIEW_RANGE)
+    obj = scene.model.body("object").id
+    seen = (geom >= 0) & (scene.model.geom_bodyid[np.maximum(geom, 0)] == obj)
+    rays = intr.rays().reshape(-1, 3) @ R_world_camera.T
+    with np.errstate(divide="ignore", invalid="ignore"):
+        on_table = eye - (eye[2] / rays[:, 2])[:, None] * rays
+    points = scene.object.points() @ scene.data.xmat[obj].reshape(3, 3).T + scene.data.xpos[obj]
+    lo, hi = points[:, :2].min(axis=0), points[:, :2].max(axis=0)
+    under = np.flatnonzero((rays[:, 2] < 0) & np.all((on_table[:, :2] >= lo) & (on_table[:, :2] <= hi), axis=1))
+    footprint = np.zeros(len(rays), dtype=bool)
+    start, down, hit, groups = np.array([0.0, 0.0, points[:, 2].max() + 0.05]), np.array([0.0, 0.0, -1.0]), \
+        np.zeros(1, np.int32), _groups(False)
+    for i in under:
+        start[:2] = on_table[i, :2]
+        mujoco.mj_ray(scene.model, scene.data, start, down, groups, 1, -1, hit)
+        footprint[i] = hit[0] >= 0 and scene.model.geom_bodyid[hit[0]] == obj
+    return seen, footprint.reshape(seen.shape)
+
+
+def _view(scene: Scene, view):
+    if view is None:
+        return scene.camera.position, R_WORLD_CAMERA
+    eye, R_world_camera = view
+    return np.asarray(eye, dtype=float), np.asarray(R_world_camera, dtype=float)
+
+
+def _groups(show_hand: bool) -> np.ndarray:
+    groups = np.zeros(6, dtype=np.uint8)
+    groups[list(SCENE_GROUPS) + ([2] if show_hand else [])] = 1
+    return groups
+
+
 def _cast(scene: Scene, eye, R_world_camera, intr: Intrinsics, show_hand: bool, max_distance: float):
-    """Colour (H, W, 3) uint8 and depth along the optical axis (H, W) float (0: no hit) by one ray per pixel."""
+    """Colour (H, W, 3) uint8, depth along the optical axis (H, W) float (0: no hit) and geom hit (H, W) int (-1: none)."""
     rays_world = np.ascontiguousarray(intr.rays().reshape(-1, 3) @ np.asarray(R_world_camera).T)
     n = len(rays_world)
     geom = np.empty(n, dtype=np.int32)
     dist = np.empty(n, dtype=np.float64)
     normal = np.empty((n, 3), dtype=np.float64)
-    groups = np.zeros(6, dtype=np.uint8)
-    groups[list(SCENE_GROUPS) + ([2] if show_hand else [])] = 1
-    mujoco.mj_multiRay(scene.model, scene.data, np.asarray(eye, dtype=float), rays_world.ravel(), groups, 1, -1,
-                       geom, dist, normal.ravel(), n, max_distance)
+    mujoco.mj_multiRay(scene.model, scene.data, np.asarray(eye, dtype=float), rays_world.ravel(), _groups(show_hand),
+                       1, -1, geom, dist, normal.ravel(), n, max_distance)
     hit = geom >= 0
     rgb = _shade(scene.model.geom_rgba[geom, :3], normal, rays_world, hit)
     shape = (intr.height, intr.width)
-    return rgb.reshape(*shape, 3), np.where(hit, dist, 0.0).reshape(shape)
+    return rgb.reshape(*shape, 3), np.where(hit, dist, 0.0).reshape(shape), geom.reshape(shape)
 
 
 def _shade(colour: np.ndarray, normal: np.ndarray, rays: np.ndarray, hit: np.ndarray) -> np.ndarray:
