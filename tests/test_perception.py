@@ -320,6 +320,22 @@ def test_a_wide_shadow_is_not_a_flat_part_because_lightness_counts_little():
     assert segment(rgb, depth, CAMERA, colour_options={"lightness_weight": 1.0}).method == "depth+rgb"
 
 
+def test_a_dark_grey_flat_part_on_a_light_grey_table_is_found_by_its_lightness():
+    # Grey on grey differs in lightness only (CIELAB distance 33 with lightness weighted 0.25): the part, at
+    # 0.37 of the table's lightness, is darker than a shadow; the shadow on the other side, at 0.63, is not.
+    depth, rgb, truth, _ = render(tilt_deg=12.7, height=0.02)
+    rgb[~truth] = 200
+    rgb, whole = with_flat_part(rgb, truth, colour=(70, 70, 70))
+    rows, cols = np.nonzero(truth)
+    shadow = np.zeros_like(truth)
+    shadow[rows.min(): rows.max(), cols.min() - 40: cols.min()] = True
+    rgb[shadow & ~truth] = 120
+    standing = render_footprint(tilt_deg=12.7) | (whole & ~truth)
+    seg = segment(rgb, depth, CAMERA)
+    assert seg.method == "depth+rgb" and iou(seg.mask, standing) > 0.95
+    assert segment(rgb, depth, CAMERA, colour_options={"shadow_lightness": 0.0}).method == "depth"
+
+
 def test_auto_finds_a_flat_object_of_another_colour():
     depth, rgb, _, _ = render(kind="none")
     flat = np.zeros((H, W), dtype=bool)
@@ -604,6 +620,8 @@ def test_bad_input_messages():
         (lambda: add_flat_parts(rgb, segment_rgb(rgb)), "needs a depth segmentation"),
         (lambda: add_flat_parts(rgb, segment_depth(depth, CAMERA), colour_distance=0), "colour_distance must be positive"),
         (lambda: add_flat_parts(rgb, segment_depth(depth, CAMERA), lightness_weight=2), r"lightness_weight must be in \[0, 1\]"),
+        (lambda: add_flat_parts(rgb, segment_depth(depth, CAMERA), shadow_lightness=-0.1),
+         r"shadow_lightness must be in \[0, 1\]"),
         (lambda: contour_to_metric(segment_depth(depth, CAMERA).contour_px, depth, CAMERA, depth_mode="plane",
                                    on_table=True), "a footprint lies on the table"),
         (lambda: add_flat_parts(rgb[:10], segment_depth(depth, CAMERA)), "rgb image is 640x10 but mask is 640x480"),

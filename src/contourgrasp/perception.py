@@ -133,6 +133,10 @@ COLOUR_DISTANCE = 50.0
 #: Weight of lightness in that distance: shadows darken the table without changing its hue.
 LIGHTNESS_WEIGHT = 0.25
 
+#: A pixel darker than this fraction of the table's CIELAB lightness is object whatever its hue: darker
+#: than a soft shadow, which would have to block about 80 % of the light (the table's 8-bit colour x 0.48).
+SHADOW_LIGHTNESS = 0.5
+
 #: Colour evidence within this distance (px) of the depth mask is shadow or the object's side;
 #: only parts farther out are added to the depth mask.
 HALO_PX = 8
@@ -930,18 +934,22 @@ def add_flat_parts(
     *,
     colour_distance: float = COLOUR_DISTANCE,
     lightness_weight: float = LIGHTNESS_WEIGHT,
+    shadow_lightness: float = SHADOW_LIGHTNESS,
     halo_px: int = HALO_PX,
     min_area_px: int = MIN_AREA_PX,
 ) -> Segmentation:
     """Add to a depth segmentation the parts of the object too flat for depth to see.
 
     1. Colour evidence: the pixels whose colour is more than
-       ``colour_distance`` from the table's, opened with a 5 x 5 element to
+       ``colour_distance`` from the table's, or whose lightness is below
+       ``shadow_lightness`` times the table's, opened with a 5 x 5 element to
        drop thin straps and specks, and connected to the depth mask. The
        table's colour is the median CIELAB colour of the table-plane inliers
        ``halo_px`` to ``4 * halo_px`` pixels around the depth mask; the
        distance weighs lightness by ``lightness_weight``, because a shadow on
-       the table changes its lightness far more than its hue.
+       the table changes its lightness far more than its hue. A dark grey
+       part on a light grey table differs in lightness only, hence the second
+       test: no soft shadow is that dark.
     2. Flat parts: the colour evidence farther than ``halo_px`` from the depth
        mask, in pieces of at least ``min_area_px``. Nearer evidence is the
        band of shadow and the object's side seen by a tilted camera, which
@@ -969,6 +977,8 @@ def add_flat_parts(
         the lightness is multiplied by ``lightness_weight``.
     lightness_weight : float
         Weight of the lightness difference, 0-1.
+    shadow_lightness : float
+        Fraction of the table's lightness below which a pixel is object, 0-1 (0: no such test).
     halo_px : int
         As above, pixels.
     min_area_px : int
@@ -987,15 +997,15 @@ def add_flat_parts(
     image = _as_rgb(rgb)
     _check_same_size(image.shape, seg.mask.shape, "rgb image", "mask")
     colour_distance = _check_positive("colour_distance", colour_distance)
-    lightness_weight = _check_finite("lightness_weight", lightness_weight)
-    if not 0.0 <= lightness_weight <= 1.0:
-        raise InputError(f"lightness_weight must be in [0, 1], got {lightness_weight}")
+    lightness_weight = _check_fraction("lightness_weight", lightness_weight)
+    shadow_lightness = _check_fraction("shadow_lightness", shadow_lightness)
     halo_px = _check_int("halo_px", halo_px, 1)
     min_area_px = _check_int("min_area_px", min_area_px, 1)
     if seg.plane is None or seg.plane.inliers.shape != seg.mask.shape:
         raise InputError("add_flat_parts needs a depth segmentation with its table plane")
     halo = _dilate(seg.mask, halo_px)
-    unlike = _unlike_table(image, seg.mask, halo, seg.plane.inliers, colour_distance, lightness_weight, halo_px)
+    unlike = _unlike_table(image, seg.mask, halo, seg.plane.inliers, colour_distance, lightness_weight,
+                           shadow_lightness, halo_px)
     _, labels, stats, _ = cv2.connectedComponentsWithStats((unlike & ~halo).astype(np.uint8), connectivity=8)
     large = stats[:, cv2.CC_STAT_AREA] >= min_area_px
     large[0] = False
@@ -1008,7 +1018,7 @@ def add_flat_parts(
     return replace(result, warnings=(*seg.warnings, *result.warnings))
 
 
-def _unlike_table(image, depth_mask, halo, table, colour_distance, lightness_weight, halo_px):
+def _unlike_table(image, depth_mask, halo, table, colour_distance, lightness_weight, shadow_lightness, halo_px):
     """(H, W) bool: pixels of a colour unlike the table's, opened, connected to ``depth_mask`` (without it).
 
     ``halo`` is the depth mask dilated by ``halo_px``.
@@ -1019,9 +1029,11 @@ def _unlike_table(image, depth_mask, halo, table, colour_distance, lightness_wei
         return np.zeros(depth_mask.shape, dtype=bool)
     # Squared distance per channel by table look-up, summed: 8-bit values less a median (a multiple
     # of 0.5) square to multiples of 0.25 below 2^16, which float32 and their sum hold exactly.
-    squares = (np.arange(256.0)[:, None] - np.median(lab[ring], axis=0)) ** 2
+    table_lab = np.median(lab[ring], axis=0)
+    squares = (np.arange(256.0)[:, None] - table_lab) ** 2
     per_channel = cv2.LUT(lab, squares.astype(np.float32)[None])
     unlike = cv2.transform(per_channel, np.array([[lightness_weight ** 2, 1.0, 1.0]])) > np.float64(colour_distance) ** 2
+    unlike |= lab[..., 0] < shadow_lightness * table_lab[0]
     return _connected_to(_open(unlike, 2) | depth_mask, depth_mask) & ~depth_mask
 
 
@@ -1656,6 +1668,13 @@ def _check_finite(name, value) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) or not math.isfinite(value):
         raise InputError(f"{name} must be a finite number, got {value!r}")
     return float(value)
+
+
+def _check_fraction(name, value) -> float:
+    value = _check_finite(name, value)
+    if not 0.0 <= value <= 1.0:
+        raise InputError(f"{name} must be in [0, 1], got {value}")
+    return value
 
 
 def _check_positive(name, value) -> float:

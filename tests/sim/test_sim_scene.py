@@ -7,6 +7,7 @@ import contourgrasp
 from contourgrasp import perception
 from contourgrasp.sim import (Camera, DepthNoise, build_scene, hand_pose_from_matrix, object_truth, render,
                               render_view, tilted_view)
+from contourgrasp.sim.objects import flat_tool
 from contourgrasp.sim.planners import camera_intrinsics, make_planner
 from contourgrasp.sim.scene import R_WORLD_CAMERA, Workspace
 
@@ -123,3 +124,15 @@ def test_footprint_segmentation_matches_the_exact_footprint_of_a_tilted_view():
 
     assert iou(footprint) > 0.9
     assert iou(seen) < iou(footprint) - 0.1  # the footprint, not the region seen
+
+
+def test_flat_parts_and_registration_against_exact_truth():
+    # A dark grey tool whose plate depth cannot see, on the light table, colour misregistered by (1, -3) px.
+    scene = build_scene(flat_tool(), seed=1, camera=Camera(height=0.7))
+    view = tilted_view(TILT, 0.7)
+    rgb, depth = render(scene, noise=True, seed=1, view=view)
+    _, footprint = object_truth(scene, view)
+    misregistered = perception.register_colour(rgb, (-1, 3))
+    result = perception.segment(misregistered, depth, camera_intrinsics(scene.camera.intrinsics))
+    assert result.method == "depth+rgb" and result.colour_offset_px == (1, -3)
+    assert (result.mask & footprint).sum() / (result.mask | footprint).sum() > 0.9

@@ -209,6 +209,18 @@ def stone2() -> ObjectSpec:
                       rgba=(0.55, 0.47, 0.38, 1.0))
 
 
+def flat_tool() -> ObjectSpec:
+    """A dark grey tool for perception checks: a 4 mm plate 0.08 x 0.06 m with a 0.12 x 0.024 x 0.024 m grip.
+
+    Like the can opener of the shared real frames, depth sees the grip and
+    not the plate, and its grey differs from the table's in lightness only.
+    """
+    plate = Part("box", (0.04, 0.03, 0.002), pos=(0.0, 0.0, 0.002))
+    grip = Part("box", (0.06, 0.012, 0.012), pos=(0.09, 0.0, 0.012))
+    return ObjectSpec("tool", (plate, grip), mass=0.10, friction_hand=0.60, friction_table=0.40,
+                      rgba=(0.20, 0.22, 0.20, 1.0))
+
+
 #: The thesis's test objects by name (Table 4.4 plus the standing can).
 THESIS_OBJECTS = {
     "can": soda_can,
