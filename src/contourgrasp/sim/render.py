@@ -32,6 +32,8 @@ SCENE_GROUPS = (0, 1)
 VIEW_INTRINSICS = Intrinsics(fx=300.0, fy=300.0, cx=159.5, cy=119.5, width=320, height=240)
 #: Farthest hit :func:`render_view` looks for, m.
 VIEW_RANGE = 5.0
+#: :func:`object_truth` looks for the object this far (m) beyond its collision parts' extent.
+TRUTH_MARGIN = 0.05
 
 
 @dataclass(frozen=True)
@@ -153,12 +155,13 @@ def object_truth(scene: Scene, view=None) -> tuple[np.ndarray, np.ndarray]:
     rays = intr.rays().reshape(-1, 3) @ R_world_camera.T
     with np.errstate(divide="ignore", invalid="ignore"):
         on_table = eye - (eye[2] / rays[:, 2])[:, None] * rays
+    # Only table points within the object's plan extent (with a margin for drawn meshes) need a vertical ray.
     points = scene.object.points() @ scene.data.xmat[obj].reshape(3, 3).T + scene.data.xpos[obj]
-    lo, hi = points[:, :2].min(axis=0), points[:, :2].max(axis=0)
+    lo, hi = points[:, :2].min(axis=0) - TRUTH_MARGIN, points[:, :2].max(axis=0) + TRUTH_MARGIN
     under = np.flatnonzero((rays[:, 2] < 0) & np.all((on_table[:, :2] >= lo) & (on_table[:, :2] <= hi), axis=1))
     footprint = np.zeros(len(rays), dtype=bool)
-    start, down, hit, groups = np.array([0.0, 0.0, points[:, 2].max() + 0.05]), np.array([0.0, 0.0, -1.0]), \
-        np.zeros(1, np.int32), _groups(False)
+    start = np.array([0.0, 0.0, points[:, 2].max() + TRUTH_MARGIN])
+    down, hit, groups = np.array([0.0, 0.0, -1.0]), np.zeros(1, np.int32), _groups(False)
     for i in under:
         start[:2] = on_table[i, :2]
         mujoco.mj_ray(scene.model, scene.data, start, down, groups, 1, -1, hit)
