@@ -1525,10 +1525,16 @@ def contour_to_metric(
 
 
 def _standing_on(depth, intrinsics, plane, inside, valid):
-    """(rows, cols) of the valid pixels whose footprint lies in ``inside``: the table there and what stands on it."""
+    """(rows, cols) of the valid pixels whose footprint lies in ``inside``: the table there and what stands on it.
+
+    Only the above-table regions that overlap ``inside`` are moved onto the
+    table: an object seen by a tilted camera overlaps its own footprint (its
+    near side reaches down to it), and the rest of the scene (a gripper,
+    clutter: ten times the object's pixels on the shared frames) is skipped.
+    """
     with np.errstate(invalid="ignore"):
         above = valid & (_heights(depth, intrinsics, plane) > PLANE_THRESHOLD)
-    rows, cols = np.nonzero(above)
+    rows, cols = np.nonzero(_connected_to(above, inside & above))
     keep, u, v = _in_image(_footprint_pixels(depth, intrinsics, plane, rows, cols), inside.shape)
     keep[keep] = inside[v[keep], u[keep]]
     table_rows, table_cols = np.nonzero(inside & valid & ~above)
