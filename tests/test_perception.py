@@ -272,6 +272,16 @@ def test_colour_offset_finds_the_misregistration(dx, dy):
                                   rgb[100:-100, 100:-100])
 
 
+def test_colour_offset_survives_a_grainy_table():
+    # Pixel noise of +-100 grey levels in colour (a grainy or textured mat) has edges everywhere but none that
+    # depth shares: the object's outline still decides the shift.
+    depth, rgb, _, _ = render(tilt_deg=12.7)
+    seen = segment_depth(depth, CAMERA, footprint=False).mask
+    grain = np.random.default_rng(0).integers(-100, 101, (H, W, 1))
+    grainy = np.clip(rgb + grain, 0, 255).astype(np.uint8)
+    assert colour_offset(shifted(grainy, 2, -3), depth, seen) == (2, -3)
+
+
 def test_colour_offset_without_edges_is_zero():
     depth = np.full((H, W), 0.7)
     mask = np.zeros((H, W), dtype=bool)
