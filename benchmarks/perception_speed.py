@@ -80,7 +80,7 @@ def stage_times(rgb, depth, intrinsics, clock) -> dict[str, float]:
     seg = perception.segment(rgb, filled, intrinsics)
     times["segment"] = clock() - start
     start = clock()
-    perception.contour_to_metric(seg.contour_px, filled, intrinsics, plane=seg.plane)
+    perception.contour_to_metric(seg.contour_px, filled, intrinsics, plane=seg.plane, on_table=seg.on_table)
     times["metric"] = clock() - start
     start = clock()
     pipeline.perceive(rgb, depth, intrinsics)
