@@ -19,6 +19,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 from scipy import ndimage
 
+from contourgrasp import perception
 from contourgrasp.errors import InputError
 from contourgrasp.perception import (
     APPROACH_OFFSET,
@@ -256,6 +257,35 @@ def test_auto_adds_a_flat_part_that_depth_cannot_see():
     assert seg.on_table and seg.colour_offset_px == (0, 0)
     assert iou(seg.mask, standing) > 0.95
     np.testing.assert_array_equal(segment(rgb, depth, CAMERA).mask, seg.mask)
+
+
+def with_plate(rgb, truth, length):
+    """The scene with a light plate 30 px wide reaching ``length`` px to the right of the object."""
+    rows, cols = np.nonzero(truth)
+    plate = np.zeros_like(truth)
+    plate[rows.min() + 5: rows.min() + 35, cols.max() - 2: cols.max() + length] = True
+    painted = rgb.copy()
+    painted[plate & ~truth] = (230, 230, 230)
+    return painted, truth | plate
+
+
+def test_a_flat_part_beyond_the_search_window_is_found_whole():
+    # The plate reaches 200 px beyond the object, past the window searched first: the whole image is searched.
+    assert 200 > 4 * perception.HALO_PX + perception.FLAT_WINDOW_PX
+    depth, rgb, truth, _ = render(height=0.02)
+    rgb, whole = with_plate(rgb, truth, 200)
+    seg = segment(rgb, depth, CAMERA)
+    assert seg.method == "depth+rgb" and iou(seg.mask, whole) > 0.97
+
+
+@pytest.mark.parametrize("length", [60, 200])
+def test_the_search_window_changes_nothing(monkeypatch, length):
+    depth, rgb, truth, _ = render(tilt_deg=12.7, height=0.02)
+    rgb, _ = with_plate(rgb, truth, length)
+    windowed = segment(rgb, depth, CAMERA)
+    assert windowed.method == "depth+rgb"
+    monkeypatch.setattr(perception, "FLAT_WINDOW_PX", 10_000)  # the window is the whole image
+    np.testing.assert_array_equal(segment(rgb, depth, CAMERA).mask, windowed.mask)
 
 
 def shifted(rgb, dx, dy):

@@ -141,6 +141,13 @@ SHADOW_LIGHTNESS = 0.5
 #: only parts farther out are added to the depth mask.
 HALO_PX = 8
 
+#: Colour evidence is opened with a disc of this radius (px) to drop thin straps and specks.
+EVIDENCE_OPEN_PX = 2
+
+#: Colour evidence is first looked for within this distance (px) beyond the table ring around the depth
+#: mask; the whole image is searched only when the evidence reaches that window's edge.
+FLAT_WINDOW_PX = 96
+
 #: Largest colour-depth misregistration searched for, pixels in each direction.
 MAX_COLOUR_OFFSET_PX = 8
 
@@ -1021,9 +1028,26 @@ def add_flat_parts(
 def _unlike_table(image, depth_mask, halo, table, colour_distance, lightness_weight, shadow_lightness, halo_px):
     """(H, W) bool: pixels of a colour unlike the table's, opened, connected to ``depth_mask`` (without it).
 
-    ``halo`` is the depth mask dilated by ``halo_px``.
+    ``halo`` is the depth mask dilated by ``halo_px``. The work is done in a
+    window ``FLAT_WINDOW_PX`` beyond the table ring around the depth mask (a
+    fraction of the frame), and again on the whole image only when the
+    evidence found comes within reach of the opening of the window's edges
+    inside the image, where it could continue: the result is the whole
+    image's either way.
     """
-    lab = cv2.cvtColor(image, cv2.COLOR_RGB2LAB)
+    window = _grown_box(depth_mask, 4 * halo_px + FLAT_WINDOW_PX)
+    options = (colour_distance, lightness_weight, shadow_lightness, halo_px)
+    found = _unlike_in(image[window], depth_mask[window], halo[window], table[window], *options)
+    if _reaches_inner_edge(found, window, depth_mask.shape, 2 * EVIDENCE_OPEN_PX + 1):
+        return _unlike_in(image, depth_mask, halo, table, *options)
+    unlike = np.zeros(depth_mask.shape, dtype=bool)
+    unlike[window] = found
+    return unlike
+
+
+def _unlike_in(image, depth_mask, halo, table, colour_distance, lightness_weight, shadow_lightness, halo_px):
+    """:func:`_unlike_table` on the given arrays (the whole image or a window holding the table ring)."""
+    lab = cv2.cvtColor(np.ascontiguousarray(image), cv2.COLOR_RGB2LAB)
     ring = _dilate(depth_mask, 4 * halo_px) & ~halo & table
     if not ring.any():
         return np.zeros(depth_mask.shape, dtype=bool)
@@ -1034,7 +1058,15 @@ def _unlike_table(image, depth_mask, halo, table, colour_distance, lightness_wei
     per_channel = cv2.LUT(lab, squares.astype(np.float32)[None])
     unlike = cv2.transform(per_channel, np.array([[lightness_weight ** 2, 1.0, 1.0]])) > np.float64(colour_distance) ** 2
     unlike |= lab[..., 0] < shadow_lightness * table_lab[0]
-    return _connected_to(_open(unlike, 2) | depth_mask, depth_mask) & ~depth_mask
+    return _connected_to(_open(unlike, EVIDENCE_OPEN_PX) | depth_mask, depth_mask) & ~depth_mask
+
+
+def _reaches_inner_edge(region, window, shape, width) -> bool:
+    """Whether ``region`` (the ``window`` of an image of ``shape``) has a pixel within ``width`` of a window edge
+    that is not the image's edge."""
+    rows, cols = window
+    return bool((rows.start > 0 and region[:width].any()) or (rows.stop < shape[0] and region[-width:].any())
+                or (cols.start > 0 and region[:, :width].any()) or (cols.stop < shape[1] and region[:, -width:].any()))
 
 
 def colour_offset(rgb, depth, mask, *, max_offset_px: int = MAX_COLOUR_OFFSET_PX) -> tuple[int, int]:
@@ -1149,11 +1181,18 @@ def _morph(operation, mask, radius):
     pixel is inside it (or beyond the image's edge, as on the whole image).
     """
     out = np.zeros(mask.shape, dtype=bool)
-    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
-    if len(rows):
-        box = np.s_[max(rows[0] - radius, 0): rows[-1] + radius + 1, max(cols[0] - radius, 0): cols[-1] + radius + 1]
+    if mask.any():
+        box = _grown_box(mask, radius)
         out[box] = cv2.morphologyEx(mask[box].astype(np.uint8), operation, _disc(radius)) > 0
     return out
+
+
+def _grown_box(mask, margin):
+    """(rows, cols) slices of ``mask``'s bounding box grown by ``margin`` px, within the image; ``mask`` is not empty."""
+    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+    height, width = mask.shape
+    return (slice(max(rows[0] - margin, 0), min(rows[-1] + margin + 1, height)),
+            slice(max(cols[0] - margin, 0), min(cols[-1] + margin + 1, width)))
 
 
 def segment(
