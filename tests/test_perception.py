@@ -34,6 +34,7 @@ from contourgrasp.perception import (
     approach_depth,
     colour_offset,
     contour_to_metric,
+    denoised_depth,
     fill_depth_holes,
     fit_plane,
     fit_table_plane,
@@ -623,13 +624,23 @@ def test_unknown_table_assumes_the_thesis_planes():
 
 
 def test_approach_depth_is_the_nearest_reading_plus_offset():
-    depth = np.full((10, 10), 0.8)
-    depth[4, 4], depth[5, 5], depth[6, 6] = 0.5, 0.0, 0.1
-    mask = np.zeros((10, 10), bool)
-    mask[3:8, 3:8] = True
+    depth = np.full((12, 12), 0.8)
+    depth[3:6, 3:6] = 0.5  # the object's top, 3 x 3 pixels
+    depth[7, 7], depth[8, 8] = 0.1, 0.0  # a flying pixel and a missing reading
+    mask = np.zeros((12, 12), bool)
+    mask[2:10, 2:10] = True
     assert approach_depth(depth, mask, offset=0.02) == pytest.approx(0.52)
     with pytest.raises(InputError, match="no valid depth inside the object"):
-        approach_depth(depth, np.zeros((10, 10), bool))
+        approach_depth(depth, np.zeros((12, 12), bool))
+
+
+def test_denoised_depth_keeps_readings_next_to_holes():
+    depth = np.full((6, 6), 0.7)
+    depth[:2] = 0.0
+    depth[2, 2] = 0.6  # a nearer speck: filtered out
+    denoised = denoised_depth(depth, depth > 0)
+    assert np.all(denoised[:2] == 0.0)  # windows mostly missing keep their own (missing) reading
+    np.testing.assert_allclose(denoised[2:], 0.7)
 
 
 # ---------------------------------------------------------------------------

@@ -12,7 +12,9 @@ Hand frame (``T_camera_hand``)
     yaw; z axis the approach direction: the camera's z (palm facing along it,
     toward the table) or, for a tilted camera, the table's normal pointing
     into the table. ``approach_depth`` = nearest valid depth inside the contour
-    plus ``approach_offset`` (section 3.1.1): the fingertips' plane reaches
+    (after a 3 x 3 median filter against sensor noise, see
+    :func:`contourgrasp.perception.approach_depth`) plus ``approach_offset``
+    (section 3.1.1): the fingertips' plane reaches
     that far, ``approach_offset`` below the object's top.
 """
 
