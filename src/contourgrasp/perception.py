@@ -1401,7 +1401,9 @@ def approach_depth(depth, mask, *, offset: float = APPROACH_OFFSET, depth_range=
     ``APPROACH_MEDIAN_PX`` (3 x 3) pixels (:func:`denoised_depth`): the
     minimum of raw readings is their noise's extreme, a few millimetres nearer
     than the surface (which would eat half of the 1 cm offset), or a single
-    flying pixel. The thesis adds "a small offset, since we do not want the end-effector to
+    flying pixel.
+
+    The thesis adds "a small offset, since we do not want the end-effector to
     collide with the object" without giving its sign convention. Read
     literally, a positive offset puts the target *beyond* the nearest surface
     along the optical axis; pass a negative one for a stand-off. The value is
