@@ -45,9 +45,7 @@ def height_error(scene, view, rgb, depth) -> float:
         plan = contourgrasp.plan_grasp(rgb, depth, camera_intrinsics(CAMERA.intrinsics), hand=HAND)
     eye, R_world_camera = view
     hand_z = eye[2] + R_world_camera[2] @ plan.T_camera_hand[:3, 3]
-    body = scene.model.body("object").id
-    top = (scene.object.points() @ scene.data.xmat[body].reshape(3, 3).T)[:, 2].max() + scene.data.xpos[body][2]
-    return hand_z - (top - perception.APPROACH_OFFSET)
+    return hand_z - (scene.object_points()[:, 2].max() - perception.APPROACH_OFFSET)
 
 
 def main(argv=None) -> int:

@@ -156,7 +156,7 @@ def object_truth(scene: Scene, view=None) -> tuple[np.ndarray, np.ndarray]:
     with np.errstate(divide="ignore", invalid="ignore"):
         on_table = eye - (eye[2] / rays[:, 2])[:, None] * rays
     # Only table points within the object's plan extent (with a margin for drawn meshes) need a vertical ray.
-    points = scene.object.points() @ scene.data.xmat[obj].reshape(3, 3).T + scene.data.xpos[obj]
+    points = scene.object_points()
     lo, hi = points[:, :2].min(axis=0) - TRUTH_MARGIN, points[:, :2].max(axis=0) + TRUTH_MARGIN
     under = np.flatnonzero((rays[:, 2] < 0) & np.all((on_table[:, :2] >= lo) & (on_table[:, :2] <= hi), axis=1))
     footprint = np.zeros(len(rays), dtype=bool)

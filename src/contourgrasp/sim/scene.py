@@ -161,6 +161,11 @@ class Scene:
         """(3,) float: the object's centre of mass, world."""
         return self.data.xipos[self._object_body].copy()
 
+    def object_points(self) -> np.ndarray:
+        """(p, 3) float: surface points of the object's collision parts where it lies now, world."""
+        rotation = self.data.xmat[self._object_body].reshape(3, 3)
+        return self.object.points() @ rotation.T + self.data.xpos[self._object_body]
+
     def palm_pose(self) -> tuple[np.ndarray, np.ndarray]:
         """World position (3,) and rotation (3, 3) of the hand frame."""
         return self.data.xpos[self._palm].copy(), self.data.xmat[self._palm].reshape(3, 3).copy()
