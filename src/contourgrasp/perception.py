@@ -47,7 +47,7 @@ Readings of ours (where the thesis is silent)
   or the table's edge. On the shared PrimeSense frames it scores 0.89-0.95 IoU
   against the hand-made masks where the RGB steps score 0.47-0.70, except on
   the can opener (frame 6), lying flat, of which depth sees only the raised
-  key (0.23). So, with a colour image, :func:`add_flat_parts` then grows the
+  grip (0.23). So, with a colour image, :func:`add_flat_parts` then grows the
   depth mask by colour: the pixels unlike the table's colour connected to
   it, of which only the parts more than ``HALO_PX`` beyond the depth outline
   and of at least ``min_area_px`` are added (method ``"depth+rgb"``; frame 6:
