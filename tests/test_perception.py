@@ -643,6 +643,18 @@ def test_denoised_depth_keeps_readings_next_to_holes():
     np.testing.assert_allclose(denoised[2:], 0.7)
 
 
+@pytest.mark.parametrize("corner", [(0, 0), (5, 7), (9, 11)])
+def test_denoised_depth_on_a_box_equals_the_whole_image(corner):
+    rng = np.random.default_rng(1)
+    depth = rng.uniform(0.6, 0.8, (10, 12))
+    depth[rng.random((10, 12)) < 0.3] = 0.0
+    valid = depth > 0
+    rows = np.array([corner[0], 4, 5])
+    cols = np.array([corner[1], 6, 5])
+    np.testing.assert_array_equal(perception._denoised_at(depth, valid, rows, cols),
+                                  denoised_depth(depth, valid)[rows, cols])
+
+
 # ---------------------------------------------------------------------------
 # Bad input
 # ---------------------------------------------------------------------------

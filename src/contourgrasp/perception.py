@@ -699,7 +699,11 @@ def fit_table_plane(
 
 def _points(depth, intrinsics, rows, cols) -> np.ndarray:
     """(..., 3) float: camera-frame points of the pixels (rows, cols), index arrays of any one shape (eq 3.1-3.2)."""
-    z = depth[rows, cols]
+    return _points_at(depth[rows, cols], intrinsics, rows, cols)
+
+
+def _points_at(z, intrinsics, rows, cols) -> np.ndarray:
+    """:func:`_points` with the pixels' depths ``z`` given."""
     return np.stack([(cols - intrinsics.cx) * z / intrinsics.fx, (rows - intrinsics.cy) * z / intrinsics.fy, z], axis=-1)
 
 
@@ -1434,7 +1438,7 @@ def approach_depth(depth, mask, *, offset: float = APPROACH_OFFSET, depth_range=
     if not (m & valid).any():
         lo, hi = _check_range(depth_range)
         raise InputError(f"no valid depth inside the object: all {int(m.sum())} pixels are 0, NaN or outside [{lo}, {hi}] m")
-    return float(denoised_depth(d, valid)[m & valid].min()) + offset
+    return float(_denoised_at(d, valid, *np.nonzero(m & valid)).min()) + offset
 
 
 def denoised_depth(depth, valid) -> np.ndarray:
@@ -1458,6 +1462,18 @@ def denoised_depth(depth, valid) -> np.ndarray:
     """
     smooth = cv2.medianBlur(np.where(valid, depth, np.inf).astype(np.float32), APPROACH_MEDIAN_PX)
     return np.where(np.isfinite(smooth), smooth, depth)
+
+
+def _denoised_at(depth, valid, rows, cols) -> np.ndarray:
+    """(n,) float: :func:`denoised_depth` at the pixels (rows, cols), not empty.
+
+    The filter runs on their bounding box grown by its reach only: inside the box every window is
+    the whole image's, and where the box meets the image's edge it is that edge.
+    """
+    reach = APPROACH_MEDIAN_PX // 2
+    top, left = max(rows.min() - reach, 0), max(cols.min() - reach, 0)
+    box = np.s_[top: rows.max() + reach + 1, left: cols.max() + reach + 1]
+    return denoised_depth(depth[box], valid[box])[rows - top, cols - left]
 
 
 def contour_to_metric(
@@ -1583,7 +1599,7 @@ def contour_to_metric(
         level = heights[outline[rows, cols]].min() if depth_mode == "max" else heights.max()
     rotation = _plane_frame(reference.normal)
     origin, xy = _intersect(rays, reference, float(level), rotation)
-    nearest = _points(denoised_depth(d, valid), intrinsics, rows, cols) @ rotation[:, 2]
+    nearest = _points_at(_denoised_at(d, valid, rows, cols), intrinsics, rows, cols) @ rotation[:, 2]
     return MetricContour(
         contour_xy=xy,
         R_camera_plane=rotation,
