@@ -2,8 +2,9 @@
 
 The approach depth (section 3.1.1) puts the fingertips' plane ``approach_offset`` (1 cm) below the
 object's top. For the five thesis objects, ``--seeds`` placements each, the simulation renders the
-frame (:func:`contourgrasp.sim.render`) from a camera 0.7 m from the table, looking straight down and
-tilted 12.7 deg (:func:`contourgrasp.sim.tilted_view`); ``plan_grasp`` plans the five-finger hand,
+frame (:func:`contourgrasp.sim.render`) from a camera 0.7 m from the table with the simulation's
+SR300 intrinsics, looking straight down and tilted 12.7 deg (:func:`contourgrasp.sim.tilted_view`);
+``plan_grasp`` plans the five-finger hand,
 and the script prints how far the hand frame's origin lies above the object's true top less 1 cm,
 in millimetres, mean (largest) over the placements:
 
