@@ -1123,13 +1123,13 @@ def colour_offset(rgb, depth, mask, *, max_offset_px: int = MAX_COLOUR_OFFSET_PX
     _check_same_size(image.shape, d.shape, "rgb image", "depth image")
     _check_same_size(np.shape(mask), d.shape, "mask", "depth image")
     r = _check_int("max_offset_px", max_offset_px, 0)
-    if not np.any(mask):
+    m = np.asarray(mask, dtype=bool)
+    if not m.any():
         raise InputError("colour_offset needs a mask with at least one object pixel")
-    rows, cols = np.flatnonzero(np.any(mask, axis=1)), np.flatnonzero(np.any(mask, axis=0))
+    rows, cols = _grown_box(m, REGISTRATION_MARGIN_PX)
     height, width = d.shape
-    top, left = max(rows[0] - REGISTRATION_MARGIN_PX, r), max(cols[0] - REGISTRATION_MARGIN_PX, r)
-    bottom = min(rows[-1] + REGISTRATION_MARGIN_PX + 1, height - r)
-    right = min(cols[-1] + REGISTRATION_MARGIN_PX + 1, width - r)
+    top, bottom = max(rows.start, r), min(rows.stop, height - r)
+    left, right = max(cols.start, r), min(cols.stop, width - r)
     if r == 0 or bottom - top < 3 or right - left < 3:
         return 0, 0
     window = np.s_[top - r: bottom + r, left - r: right + r]
@@ -1199,10 +1199,14 @@ def _morph(operation, mask, radius):
 
 def _grown_box(mask, margin):
     """(rows, cols) slices of ``mask``'s bounding box grown by ``margin`` px, within the image; ``mask`` is not empty."""
-    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
-    height, width = mask.shape
-    return (slice(max(rows[0] - margin, 0), min(rows[-1] + margin + 1, height)),
-            slice(max(cols[0] - margin, 0), min(cols[-1] + margin + 1, width)))
+    return _pixel_box(np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0)), margin, mask.shape)
+
+
+def _pixel_box(rows, cols, margin, shape):
+    """(rows, cols) slices of the bounding box of the pixels (rows, cols), not empty, grown by ``margin`` px,
+    within an image of ``shape``."""
+    return (slice(max(rows.min() - margin, 0), min(rows.max() + margin + 1, shape[0])),
+            slice(max(cols.min() - margin, 0), min(cols.max() + margin + 1, shape[1])))
 
 
 def segment(
@@ -1470,10 +1474,8 @@ def _denoised_at(depth, valid, rows, cols) -> np.ndarray:
     The filter runs on their bounding box grown by its reach only: inside the box every window is
     the whole image's, and where the box meets the image's edge it is that edge.
     """
-    reach = APPROACH_MEDIAN_PX // 2
-    top, left = max(rows.min() - reach, 0), max(cols.min() - reach, 0)
-    box = np.s_[top: rows.max() + reach + 1, left: cols.max() + reach + 1]
-    return denoised_depth(depth[box], valid[box])[rows - top, cols - left]
+    box = _pixel_box(rows, cols, APPROACH_MEDIAN_PX // 2, depth.shape)
+    return denoised_depth(depth[box], valid[box])[rows - box[0].start, cols - box[1].start]
 
 
 def contour_to_metric(
