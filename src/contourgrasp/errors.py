@@ -1,11 +1,36 @@
-"""The exceptions contourgrasp raises on purpose.
+"""The exceptions and warnings contourgrasp raises on purpose, one tree under :class:`ContourGraspError`.
 
 Anything else escaping the library is a bug. The CLI maps these to exit codes:
 :class:`InputError` and its subclasses to 2, :class:`NoFeasibleGrasp` to 3.
+
+Each area of the pipeline has its own subclass of :class:`InputError`, so a
+caller can catch "bad hand" apart from "bad image" (as mink has one error per
+area under one root)::
+
+    ContourGraspError
+    ├── InputError (ValueError)        bad input: exit 2
+    │   ├── ContourError               a contour polygon that cannot be modelled
+    │   ├── HandError                  a hand or finger that cannot be built
+    │   │   └── HandFileError          a hand file that does not follow the schema
+    │   ├── PlannerError               planner options or files (grid, gains, bounds)
+    │   ├── QualityError               contacts or friction of the grasp-quality metrics
+    │   ├── PerceptionError            images, depth, intrinsics, masks, extrinsics
+    │   │   └── SegmentationError      no usable object in the image (``kind``)
+    │   ├── SimulationError            objects, meshes and settings of the simulation and bench
+    │   └── OutputError                an output that cannot be written
+    └── NoFeasibleGrasp (RuntimeError) no pose satisfies the constraints: exit 3
+
+    ContourGraspWarning (UserWarning)
+    ├── UnitWarning                    a magnitude that suggests non-SI units
+    └── PerceptionWarning              a usable but doubtful perception result
 """
 
 
-class InputError(ValueError):
+class ContourGraspError(Exception):
+    """Root of every exception contourgrasp raises on purpose."""
+
+
+class InputError(ContourGraspError, ValueError):
     """Bad input: a file, a field or an argument that cannot be used as given."""
 
 
@@ -13,11 +38,48 @@ class ContourError(InputError):
     """A contour polygon that cannot be modelled (too few points, NaN, no area, ...)."""
 
 
-class HandFileError(InputError):
+class HandError(InputError):
+    """A hand or finger whose geometry cannot be used (zero direction, no fingers, ...)."""
+
+
+class HandFileError(HandError):
     """A hand description that does not follow the schema."""
 
 
-class NoFeasibleGrasp(RuntimeError):
+class PlannerError(InputError):
+    """Planner options or a planner file that cannot be used (a grid too large, a negative gain, ...)."""
+
+
+class QualityError(InputError):
+    """Contacts, normals or friction that the grasp-quality metrics cannot use."""
+
+
+class PerceptionError(InputError):
+    """An image, depth map, mask, intrinsics or extrinsics that cannot be used."""
+
+
+class SegmentationError(PerceptionError):
+    """No usable object in the image; ``kind`` says why.
+
+    Kinds: ``"no-plane"`` (no table plane in the depth), ``"no-object"``
+    (nothing found), ``"not-visible"`` (the object touches the image border),
+    ``"tiny"`` (the object is smaller than ``min_area_px`` or has no interior).
+    """
+
+    def __init__(self, kind: str, message: str):
+        super().__init__(message)
+        self.kind = kind
+
+
+class SimulationError(InputError):
+    """An object, mesh, hand model or bench setting the simulation cannot use."""
+
+
+class OutputError(InputError):
+    """An output file that cannot be written (a directory in the way, no permission, ...)."""
+
+
+class NoFeasibleGrasp(ContourGraspError, RuntimeError):
     """No pose of the search grid satisfies the constraints; ``reason`` says which one failed."""
 
     def __init__(self, reason: str):
@@ -25,5 +87,13 @@ class NoFeasibleGrasp(RuntimeError):
         self.reason = reason
 
 
-class UnitWarning(UserWarning):
+class ContourGraspWarning(UserWarning):
+    """Root of the warnings contourgrasp gives."""
+
+
+class UnitWarning(ContourGraspWarning):
     """Input whose magnitude suggests it is not in SI units."""
+
+
+class PerceptionWarning(ContourGraspWarning):
+    """A result that is usable but doubtful: several objects, a steep camera, a fallback."""

@@ -1,0 +1,145 @@
+"""Checks of arguments and values, in one place, for every entry point of the library.
+
+Each check takes the argument's ``name`` (as the caller's signature or file
+field spells it), returns the value converted to its plain Python or numpy
+type, and raises an :class:`~contourgrasp.errors.InputError` subclass (``error``,
+by default :class:`InputError` itself) whose message names the argument and
+says what was expected. Nothing here computes; pure checks only, so every
+module of the pipeline may import it without reaching up the pipeline.
+
+Examples
+--------
+>>> positive("xy_step", 0.01)
+0.01
+>>> positive("xy_step", "0.05")
+Traceback (most recent call last):
+...
+contourgrasp.errors.InputError: xy_step must be a finite number, got '0.05'
+"""
+
+from __future__ import annotations
+
+import math
+from inspect import Parameter, signature
+
+import numpy as np
+
+from .errors import InputError
+
+_REAL = (int, float, np.integer, np.floating)
+
+
+def finite(name: str, value, *, error: type[InputError] = InputError) -> float:
+    """``value`` as a float; refused unless a real, finite number (a bool is not a number)."""
+    if isinstance(value, bool) or not isinstance(value, _REAL) or not math.isfinite(value):
+        raise error(f"{name} must be a finite number, got {value!r}")
+    return float(value)
+
+
+def positive(name: str, value, *, error: type[InputError] = InputError) -> float:
+    """A finite number > 0."""
+    if finite(name, value, error=error) <= 0:
+        raise error(f"{name} must be positive, got {value!r}")
+    return float(value)
+
+
+def non_negative(name: str, value, *, error: type[InputError] = InputError) -> float:
+    """A finite number >= 0."""
+    if finite(name, value, error=error) < 0:
+        raise error(f"{name} must be a number >= 0, got {value!r}")
+    return float(value)
+
+
+def fraction(name: str, value, *, error: type[InputError] = InputError) -> float:
+    """A finite number in [0, 1]."""
+    value = finite(name, value, error=error)
+    if not 0.0 <= value <= 1.0:
+        raise error(f"{name} must be in [0, 1], got {value}")
+    return value
+
+
+def at_most(name: str, value: float, limit: float, unit: str = "", *, error: type[InputError] = InputError) -> float:
+    """``value`` (already a number) refused above ``limit``, the bound on the work an input may ask for."""
+    if value > limit:
+        raise error(f"{name} must be at most {limit:g}{unit}, got {value:g}{unit}")
+    return value
+
+
+def integer(name: str, value, minimum: int | None = None, *, maximum: int | None = None, odd: bool = False,
+            error: type[InputError] = InputError) -> int:
+    """An integer (not a bool) in [minimum, maximum]; ``odd`` refuses even ones."""
+    bad = isinstance(value, bool) or not isinstance(value, (int, np.integer))
+    if bad or (minimum is not None and value < minimum):
+        bound = "" if minimum is None else f" >= {minimum}"
+        raise error(f"{name} must be an integer{bound}, got {value!r}")
+    if maximum is not None and value > maximum:
+        raise error(f"{name} must be at most {maximum}, got {value}")
+    if odd and value % 2 == 0:
+        raise error(f"{name} must be odd, got {value}")
+    return int(value)
+
+
+def choice(name: str, value, choices, *, error: type[InputError] = InputError):
+    """One of ``choices`` (compared with ==, so a string is never taken for a number)."""
+    if not any(type(value) is type(c) and value == c for c in choices):
+        raise error(f"{name} must be one of {', '.join(map(repr, choices))}, got {value!r}")
+    return value
+
+
+def flag(name: str, value, *, error: type[InputError] = InputError) -> bool:
+    """A bool (numpy's too); 0, 1 and strings are refused."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise error(f"{name} must be True or False, got {value!r}")
+    return bool(value)
+
+
+def float_array(name: str, value, *, error: type[InputError] = InputError) -> np.ndarray:
+    """``value`` as a float array; complex, object or non-numeric input is refused, not cast."""
+    try:
+        array = np.asarray(value)
+    except (TypeError, ValueError):
+        raise error(f"{name} must be an array of numbers") from None
+    if array.dtype.kind in "cOUSV" or array.dtype.kind not in "biuf":
+        kind = "complex numbers" if array.dtype.kind == "c" else f"dtype {array.dtype}"
+        raise error(f"{name} must be an array of real numbers, got {kind}")
+    return array.astype(float, copy=False)
+
+
+def finite_array(name: str, value, shape: tuple[int | None, ...] | None = None, *,
+                 error: type[InputError] = InputError) -> np.ndarray:
+    """A float array of ``shape`` (None: any length on that axis) whose entries are all finite."""
+    array = float_array(name, value, error=error)
+    if shape is not None and (array.ndim != len(shape)
+                              or any(n is not None and n != m for n, m in zip(shape, array.shape))):
+        wanted = "(" + ", ".join("n" if n is None else str(n) for n in shape) + ")"
+        raise error(f"{name} must be a {wanted} array, got shape {array.shape}")
+    bad = ~np.isfinite(array)
+    if bad.any():
+        raise error(f"{name}{list(int(i) for i in np.argwhere(bad)[0])} is not finite")
+    return array
+
+
+def same_size(shape_a, shape_b, name_a: str = "rgb image", name_b: str = "depth image", *,
+              error: type[InputError] = InputError) -> None:
+    """Two images of the same width and height."""
+    if tuple(shape_a[:2]) != tuple(shape_b[:2]):
+        raise error(f"{name_a} is {shape_a[1]}x{shape_a[0]} but {name_b} is "
+                    f"{shape_b[1]}x{shape_b[0]} (width x height)")
+
+
+def keyword_defaults(function) -> dict:
+    """The keyword-only options of ``function`` with their defaults."""
+    return {p.name: p.default for p in signature(function).parameters.values() if p.kind is Parameter.KEYWORD_ONLY}
+
+
+def options(name: str, value, function, *, error: type[InputError] = InputError) -> dict:
+    """A dict of keyword options of ``function`` (None: none); unknown names are refused by name."""
+    if value is None:
+        return {}
+    if not isinstance(value, dict):
+        raise error(f"{name} must be a dict of keyword options, got {type(value).__name__}")
+    allowed = list(keyword_defaults(function))
+    unknown = sorted(set(value) - set(allowed), key=str)
+    if unknown:
+        raise error(f"{name}: unknown option {unknown[0]!r}; choose from {', '.join(allowed)}")
+    return dict(value)
