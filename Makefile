@@ -5,14 +5,14 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: test demo bench venv clean
+.PHONY: test demo bench bench-ycb venv clean
 
 venv: $(STAMP)
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
-	$(BIN)/pip install --quiet -e '.[test]'
+	$(BIN)/pip install --quiet -e '.[test,cluster]'
 	touch $(STAMP)
 
 test: $(STAMP)
@@ -27,5 +27,10 @@ bench: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/contourgrasp bench --objects can,case,bottle,stone1,stone2 --trials 20 \
 		--planners paper,default,centroid-principal-axis,random --ablation --out bench-output
 
+# The YCB object set (issue 15): the fixed train and test splits, 10 trials per object, on every core.
+bench-ycb: $(STAMP)
+	MPLBACKEND=Agg $(BIN)/contourgrasp bench --objects ycb-train,ycb-test --trials 10 \
+		--planners paper,default,centroid-principal-axis,random --workers $$(nproc) --out bench-ycb-output
+
 clean:
-	rm -rf $(VENV) demo-output bench-output .pytest_cache
+	rm -rf $(VENV) demo-output bench-output bench-ycb-output .pytest_cache

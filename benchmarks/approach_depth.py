@@ -31,7 +31,7 @@ import numpy as np
 import contourgrasp
 from contourgrasp import perception
 from contourgrasp.sim import Camera, build_scene, render, tilted_view
-from contourgrasp.sim.planners import camera_intrinsics
+from contourgrasp.tolerances import APPROACH_OFFSET
 
 OBJECTS = ("can", "case", "bottle", "stone1", "stone2")
 TILTS_DEG = (0.0, 12.7)
@@ -43,10 +43,10 @@ def height_error(scene, view, rgb, depth) -> float:
     """How far (m) the planned hand frame lies above the object's top less the approach offset."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        plan = contourgrasp.plan_grasp(rgb, depth, camera_intrinsics(CAMERA.intrinsics), hand=HAND)
+        plan = contourgrasp.plan_grasp(rgb, depth, CAMERA.intrinsics, hand=HAND)
     eye, R_world_camera = view
     hand_z = eye[2] + R_world_camera[2] @ plan.T_camera_hand[:3, 3]
-    return hand_z - (scene.object_points()[:, 2].max() - perception.APPROACH_OFFSET)
+    return hand_z - (scene.object_points()[:, 2].max() - APPROACH_OFFSET)
 
 
 def main(argv=None) -> int:
@@ -63,7 +63,7 @@ def main(argv=None) -> int:
                 view = tilted_view(np.radians(tilt), CAMERA.height)
                 errors["exact"].append(height_error(scene, view, *render(scene, view=view)))
                 noisy = render(scene, noise=True, seed=seed, view=view)
-                with mock.patch.object(perception, "denoised_depth", lambda depth, valid: depth):
+                with mock.patch.object(perception.camera, "denoised_depth", lambda depth, valid: depth):
                     errors["raw"].append(height_error(scene, view, *noisy))
                 errors["filtered"].append(height_error(scene, view, *noisy))
             cells = []

@@ -48,7 +48,6 @@ import numpy as np  # noqa: E402
 
 from contourgrasp import perception, pipeline  # noqa: E402
 from contourgrasp.sim import build_scene, render  # noqa: E402
-from contourgrasp.sim.planners import camera_intrinsics  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from segmentation import default_data  # noqa: E402
@@ -67,7 +66,7 @@ def sim_frames(seeds: int):
         for seed in range(seeds):
             scene = build_scene(name, seed=seed)
             rgb, depth = render(scene, noise=True, seed=seed)
-            yield f"sim {name} s{seed}", rgb, depth, camera_intrinsics(scene.camera.intrinsics)
+            yield f"sim {name} s{seed}", rgb, depth, scene.camera.intrinsics
 
 
 def stage_times(rgb, depth, intrinsics, clock) -> dict[str, float]:

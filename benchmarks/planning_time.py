@@ -25,7 +25,6 @@ import cv2  # noqa: E402
 from contourgrasp import load_hand, pipeline  # noqa: E402
 from contourgrasp.io.planner_file import load_planner  # noqa: E402
 from contourgrasp.sim import build_scene, render  # noqa: E402
-from contourgrasp.sim.planners import camera_intrinsics  # noqa: E402
 
 OBJECTS = ("can", "case", "bottle", "stone1", "stone2")
 RUNS, SEED = 5, 3
@@ -35,13 +34,13 @@ def frame_times(planner: str, obj: str) -> tuple[float, float]:
     """Median wall time of ``plan_grasp`` on one frame and its synthesis time, both ms."""
     scene = build_scene(obj, seed=SEED)
     rgb, depth = render(scene, noise=True, seed=SEED)
-    camera, hand = camera_intrinsics(scene.camera.intrinsics), load_hand("five-finger-linear")
+    camera, hand = scene.camera.intrinsics, load_hand("five-finger-linear")
     options = load_planner(planner).plan_options
-    pipeline.plan_grasp(rgb, depth, camera, hand, **options)  # warm-up: numba's compilation, caches
+    pipeline.plan_frame(rgb, depth, camera, hand, **options)  # warm-up: numba's compilation, caches
     walls, synthesis = [], []
     for _ in range(RUNS):
         start = time.perf_counter()
-        result = pipeline.plan_grasp(rgb, depth, camera, hand, **options)
+        result = pipeline.plan_frame(rgb, depth, camera, hand, **options)
         walls.append(1e3 * (time.perf_counter() - start))
         synthesis.append(result.plan.timing_ms["total"])
     return statistics.median(walls), statistics.median(synthesis)

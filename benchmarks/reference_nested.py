@@ -15,7 +15,7 @@ evaluated pose by pose in plain Python. Slow on purpose: it is what the
 library must agree with.
 
 This is not part of the library; ``benchmarks/search_speed.py`` and
-``tests/test_reference.py`` use it.
+``tests/synthesis/test_reference.py`` use it.
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ For every example contour and hand preset, in one process, on one core:
 
 (a) the reference (``reference_nested.reference_search``: scipy L-BFGS-B per finger per pose) on the
     thesis grid (xy_step 0.05 m, yaw_step 2 deg, D_max 0.15 m: 7 x 7 x 180 = 8820 poses), one run;
-(b) the library (``contourgrasp.synthesis.synthesize``) on the thesis grid;
+(b) the library (``contourgrasp.synthesis.search``) on the thesis grid;
 (c) the library on the dense grid (xy_step 0.01 m, yaw_step 1 deg, D_max 0.15 m: 31 x 31 x 360 =
     345,960 poses);
 (d) the library on the dense grid followed by its continuous refinement (``synthesize(refine=True)``:
@@ -137,7 +137,7 @@ def run_library(contour, hand, grid: dict, runs: int, refine: bool = False) -> L
     out = LibResult(size=grid_size(grid))
 
     def call():
-        return synthesis.synthesize(contour, hand, d_min=D_MIN, refine=refine, **grid)
+        return synthesis.search(contour, hand, d_min=D_MIN, refine=refine, **grid)
 
     try:  # warm-up: numba compilation / cache loading, first-touch of every code path
         out.plan = call()
@@ -452,7 +452,7 @@ def main(argv=None) -> int:
     print(f"Grids: thesis = xy 0.05 m, yaw 2 deg, D_max 0.15 m ({grid_size(THESIS)} poses); "
           f"dense = xy 0.01 m, yaw 1 deg, D_max 0.15 m ({grid_size(DENSE)} poses); D_min {D_MIN} m; 4 harmonics, "
           "paper curvature.")
-    print(f"Library: contourgrasp.synthesis.synthesize (EFD fit + compiled grid screen + exact re-evaluation of the "
+    print(f"Library: contourgrasp.synthesis.search (EFD fit + compiled grid screen + exact re-evaluation of the "
           f"best {max(tol.REFINE_CANDIDATES, 40)} screened poses; (d) adds refine=True: compass search from the best "
           f"{tol.REFINE_STARTS} distinct poses), median of {args.runs} runs after 1 untimed warm-up "
           "call per grid (numba JIT / cache loading excluded).")

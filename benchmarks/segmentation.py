@@ -46,7 +46,6 @@ from contourgrasp.io.camera_file import read_intrinsics, read_mask, read_rgb
 from contourgrasp.perception import SegmentationError, register_colour, segment
 from contourgrasp.sim import Camera, Intrinsics, build_scene, object_truth, render, tilted_view
 from contourgrasp.sim.objects import flat_tool
-from contourgrasp.sim.planners import camera_intrinsics
 
 #: Targets for the default method (from the perception issue).
 TARGET_MEAN, TARGET_WORST = 0.90, 0.75
@@ -59,7 +58,7 @@ SIM_OBJECTS = {"can": "can", "case": "case", "bottle": "bottle", "stone1": "ston
                "tool": flat_tool()}
 SIM_TILTS_DEG = (0.0, 12.7)
 SIM_COLOUR_SHIFT = (1, -3)
-SIM_CAMERA = Camera(height=0.7, intrinsics=Intrinsics(fx=525.0, fy=525.0, cx=319.5, cy=239.5))
+SIM_CAMERA = Camera(height=0.7, intrinsics=Intrinsics(fx=525.0, fy=525.0, cx=319.5, cy=239.5, width=640, height=480))
 
 
 def default_data() -> Path:
@@ -120,7 +119,7 @@ def simulated(seeds):
                 seen, footprint = object_truth(scene, view)
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore")
-                    result = segment(misregistered, depth, camera_intrinsics(SIM_CAMERA.intrinsics))
+                    result = segment(misregistered, depth, SIM_CAMERA.intrinsics)
                 rows.setdefault((name, tilt), []).append(
                     (iou(result.mask, seen), iou(result.mask, footprint), iou(seen, footprint), result.colour_offset_px))
     return rows
@@ -140,7 +139,7 @@ def print_simulated(seeds) -> None:
     for tilt in SIM_TILTS_DEG:
         every = [r for name in SIM_OBJECTS for r in rows[name, tilt]]
         scores = np.array([r[:3] for r in every])
-        aim = 1 if tilt > 2 else 0  # perception.TILT_PLANE_THRESHOLD: the footprint above 2 deg
+        aim = 1 if tilt > 2 else 0  # tolerances.TILT_PLANE_THRESHOLD: the footprint above 2 deg
         means += [f"**{m:.3f}**" if k == aim else f"{m:.3f}" for k, m in enumerate(scores[:, :2].mean(axis=0))]
         shifts = ", ".join(f"{shift} on {n}" for shift, n in Counter(r[3] for r in every).items())
         notes.append(f"{tilt:g} deg: auto vs its aim {scores[:, aim].min():.3f}-{scores[:, aim].max():.3f} per frame; "

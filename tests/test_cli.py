@@ -1,9 +1,15 @@
+import contextlib
+import io
 import json
+import stat
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from contourgrasp import example_contour
 from contourgrasp.cli import main
@@ -106,9 +112,87 @@ def test_missing_output_directory(tmp_path, capsys):
 
 
 def test_bad_option_values_exit_2(capsys):
-    with pytest.raises(SystemExit) as exc:
-        main(["synth", "--contour", "example:can", "--xy-step", "-1"])
-    assert exc.value.code == 2
+    assert main(["synth", "--contour", "example:can", "--xy-step", "-1"]) == 2
+
+
+@pytest.mark.parametrize("argv, line", [
+    (["synth", "--contour", "example:can", "--xy-step", "abc"],
+     "contourgrasp synth: error: argument --xy-step: must be a positive number, got 'abc' (see contourgrasp synth --help)"),
+    (["synth", "--contour", "example:can", "--friction", "nan"],
+     "contourgrasp synth: error: argument --friction: must be a number >= 0, got 'nan' (see contourgrasp synth --help)"),
+    (["synth", "--contour", "example:can", "--harmonics", "many"],
+     "contourgrasp synth: error: argument --harmonics: must be a positive integer or 'adaptive', got 'many' "
+     "(see contourgrasp synth --help)"),
+    (["plan", "--depth", "d.npy", "--intrinsics", "i.yaml", "--approach-offset=-inf"],
+     "contourgrasp plan: error: argument --approach-offset: must be a finite number, got '-inf' "
+     "(see contourgrasp plan --help)"),
+    (["bench", "--trials", "9" * 60 + "x"],
+     f"contourgrasp bench: error: argument --trials: must be a positive integer, got '{'9' * 37}...' "
+     "(see contourgrasp bench --help)"),
+    (["synth"], "contourgrasp synth: error: the following arguments are required: --contour "
+                "(see contourgrasp synth --help)"),
+    (["nope"], "contourgrasp: error: argument command: invalid choice: 'nope' (choose from 'hands', 'synth', 'plan', "
+               "'bench', 'calibrate', 'efd') (see contourgrasp --help)"),
+])
+def test_argument_errors_are_one_line_naming_help(capsys, argv, line):
+    code, out, err = run(capsys, *argv)
+    assert code == 2 and out == "" and err == line + "\n"
+
+
+def test_a_plot_directory_leaves_the_json_output_unchanged(tmp_path, capsys):
+    out = tmp_path / "out.json"
+    out.write_text("old")
+    (tmp_path / "adir").mkdir()
+    code, _, err = run(capsys, "synth", "--contour", "example:can", *FAST, "--out", out, "--plot", tmp_path / "adir")
+    assert code == 2 and err.strip().splitlines() == [f"contourgrasp: error: {tmp_path / 'adir'}: cannot write, it is a "
+                                                      "directory"]
+    assert out.read_text() == "old"
+
+
+def test_the_same_output_twice_is_refused(tmp_path, capsys):
+    target = tmp_path / "X"
+    code, _, err = run(capsys, "synth", "--contour", "example:can", *FAST, "--out", target, "--plot", target)
+    assert code == 2 and "given twice as an output" in err and len(err.strip().splitlines()) == 1
+    assert not target.exists()
+
+
+@pytest.mark.parametrize("option", ["--out", "--plot"])
+def test_an_output_never_overwrites_an_input(tmp_path, capsys, option):
+    contour = tmp_path / "c.csv"
+    np.savetxt(contour, example_contour("can"), delimiter=",")
+    before = contour.read_bytes()
+    code, _, err = run(capsys, "synth", "--contour", contour, *FAST, option, contour)
+    assert code == 2 and "would overwrite the input file" in err and contour.read_bytes() == before
+
+
+def test_an_existing_output_keeps_its_mode(tmp_path, capsys):
+    out = tmp_path / "out.json"
+    out.write_text("old")
+    out.chmod(0o600)
+    assert run(capsys, "synth", "--contour", "example:can", *FAST, "--out", out)[0] == 0
+    assert stat.S_IMODE(out.stat().st_mode) == 0o600 and json.loads(out.read_text())["hand"]
+
+
+def test_repeated_synth_runs_write_identical_plans(tmp_path, capsys):
+    plans = []
+    for name in ("a.json", "b.json"):
+        assert run(capsys, "synth", "--contour", "example:stone2", *FAST, "--out", tmp_path / name)[0] == 0
+        plans.append({k: v for k, v in json.loads((tmp_path / name).read_text()).items() if k != "timing_ms"})
+    assert plans[0] == plans[1]
+
+
+def test_importing_the_cli_loads_no_simulation_nor_plotting():
+    code = ("import sys, contourgrasp, contourgrasp.cli; heavy = ['mujoco', 'trimesh', 'coacd', 'matplotlib', "
+            "'contourgrasp.sim', 'contourgrasp.visualize']; print([m for m in heavy if m in sys.modules])")
+    out = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True, text=True).stdout
+    assert out.strip() == "[]"
+
+
+def test_mesh_names_are_distinct_and_never_a_thesis_objects():
+    from contourgrasp.cli import _mesh_names
+
+    paths = ["a/YcbMustardBottle/model.obj", "b/YcbGelatinBox/model.obj", "robosuite/bottle.obj", "x/mug.obj"]
+    assert _mesh_names(paths) == ["YcbMustardBottle", "YcbGelatinBox", "robosuite-bottle", "mug"]
 
 
 def test_console_script_has_no_traceback(tmp_path):
@@ -116,3 +200,96 @@ def test_console_script_has_no_traceback(tmp_path):
                             capture_output=True, text=True)
     assert result.returncode == 2
     assert result.stderr.strip() == f"contourgrasp: error: {tmp_path / 'x.csv'}: contour file not found"
+
+
+# --- fuzz: random argv from the real options, absurd values and malformed files --------------------------------
+
+ABSURD = ["1e-300", "1e300", "nan", "-inf", "inf", "abc", "", "0", "-1", "9" * 30, "1e309", "--", "-0"]
+#: Valid values that keep a plan fast (a coarse grid); absurd ones either fail validation or shrink the grid.
+FAST_VALUES = {
+    "--xy-step": ["0.05", "0.1", "1e300"], "--yaw-step-deg": ["30", "90", "1e300"], "--d-max": ["0.05", "0.1"],
+    "--d-min": ["0", "0.01", "1e-300"], "--harmonics": ["1", "4", "adaptive"], "--clearance": ["0", "1e-300"],
+    "--friction": ["0", "0.5", "1e300"], "--quality-gain": ["0", "1e300"], "--top-k": ["1", "3", "9" * 30],
+    "--curvature": ["paper", "geometric"], "--planner": ["paper", "default"],
+    "--hand": ["three-finger", "five-finger-linear"], "--depth-scale": ["0.001", "1e-300", "1e300"],
+    "--standoff": ["0", "0.1", "1e300"], "--approach-offset=": ["0.01", "-1e9", "1e300"],
+    "--segment": ["auto", "rgb", "depth"], "--depth-mode": ["max", "plane"], "--colour-offset": ["0,0", "1,-3"],
+}
+SWITCHES = ["--refine", "--no-refine", "--finger-thickness", "--require-closure", "--no-fill-holes", "--footprint"]
+FILE_OPTIONS = ["--hand", "--planner"]
+IMAGE_OPTIONS = ["--rgb", "--depth", "--intrinsics", "--mask", "--extrinsics"]
+
+
+@pytest.fixture(scope="module")
+def fuzz_files(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("fuzz")
+    nested_json = "[" * 100000 + "]" * 100000
+    contents = {
+        "empty": b"", "random": bytes(range(256)) * 4, "utf16": "x,y\n0,0\n1,0\n0,1\n".encode("utf-16"),
+        "json": nested_json.encode(), "yaml": ("a:\n" + "".join(" " * i + "- \n" for i in range(1, 200))).encode(),
+        "toml": ("a = " + "[" * 50000 + "]" * 50000 + "\n").encode(),
+    }
+    files = []
+    for stem, data in contents.items():
+        for suffix in (".csv", ".npy", ".toml", ".json", ".yaml", ".png", ".obj"):
+            path = folder / f"{stem}{suffix}"
+            path.write_bytes(data)
+            files.append(str(path))
+    (folder / "adir").mkdir()
+    return folder, files
+
+
+def _value(option):
+    return st.sampled_from(ABSURD + FAST_VALUES.get(option, []))
+
+
+@st.composite
+def argv_strategy(draw, files, folder):
+    command = draw(st.sampled_from(["synth", "synth", "efd", "plan", "hands", "bench", "calibrate"]))
+    any_file = st.sampled_from(files + ["example:can", "example:nope", str(folder / "missing.csv")])
+    argv = [command]
+    if command in ("synth", "efd"):
+        argv += ["--contour", draw(st.sampled_from(["example:can", "example:stone2"]) | any_file)]
+    if command == "plan":
+        for option in IMAGE_OPTIONS[:3] + draw(st.lists(st.sampled_from(IMAGE_OPTIONS[3:]), max_size=2)):
+            argv += [option, draw(any_file)]
+    if command == "bench":  # never runs a trial: a malformed mesh or an unknown planner stops it first
+        argv += ["--mesh", draw(any_file), "--planners", draw(st.sampled_from(["nope", ""])), "--trials", "1"]
+    if command == "calibrate":  # never simulates: every hand here is malformed or refused
+        argv += ["--hand", draw(any_file | st.just("five-finger-curved-thumb"))]
+    if command in ("synth", "plan"):
+        argv += ["--yaw-step-deg", draw(_value("--yaw-step-deg"))]  # bounds the grid unless the value is refused
+        for option in draw(st.lists(st.sampled_from(sorted(FAST_VALUES) + SWITCHES + FILE_OPTIONS), max_size=6)):
+            if option in SWITCHES:
+                argv.append(option)
+            elif option.endswith("="):
+                argv.append(option + draw(_value(option)))
+            else:
+                argv += [option, draw(_value(option) | any_file if option in FILE_OPTIONS else _value(option))]
+    if command == "efd":
+        argv += ["--harmonics", *draw(st.lists(_value("--harmonics"), min_size=1, max_size=3))]
+    if command in ("synth", "plan", "efd", "calibrate") and draw(st.booleans()):
+        own_inputs = [a for a in argv if a in files]  # an output naming an input must be refused
+        targets = st.sampled_from([str(folder / "out.json"), str(folder / "adir"), str(folder / "no" / "x.json"),
+                                   *own_inputs])
+        argv += [draw(st.sampled_from(["--out", "--plot"])), draw(targets)]
+    return argv
+
+
+def test_fuzz_the_command_line_never_tracebacks(fuzz_files):
+    folder, files = fuzz_files
+    before = {p: Path(p).read_bytes() for p in files}
+
+    @settings(max_examples=100, deadline=None, suppress_health_check=list(HealthCheck))
+    @given(argv=argv_strategy(files, folder))
+    def check(argv):
+        err, out = io.StringIO(), io.StringIO()
+        with contextlib.redirect_stderr(err), contextlib.redirect_stdout(out):
+            code = main(argv)
+        text = err.getvalue()
+        assert code in (0, 2, 3), (argv, text)
+        assert "Traceback" not in text and len(text.strip().splitlines()) <= 4, (argv, text)
+        assert all(len(line) < 2000 for line in text.splitlines()), argv
+
+    check()
+    assert {p: Path(p).read_bytes() for p in files} == before  # no input was ever overwritten

@@ -1,7 +1,12 @@
+import math
+
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from contourgrasp import Arc, Finger, Hand, Ray, efd, example_contour, load_hand, preset_names, synthesis
+from contourgrasp.errors import HandError
 from contourgrasp.hand import rotation, to_image
 
 PRESETS = ["five-finger-curved-thumb", "five-finger-linear", "three-finger"]
@@ -39,7 +44,7 @@ def test_a_can_at_the_grasp_centre_is_touched_by_every_finger(name):
 
 def test_ray_closing_direction_is_normalised():
     assert Ray((3.0, 4.0)).closing_direction == pytest.approx((0.6, 0.8))
-    with pytest.raises(ValueError, match="non-zero"):
+    with pytest.raises(HandError, match="non-zero"):
         Ray((0.0, 0.0))
 
 
@@ -78,14 +83,14 @@ def test_curved_thumb_ends_opposite_the_fingers():
 
 
 def test_finger_and_hand_validation():
-    with pytest.raises(ValueError, match="travel"):
+    with pytest.raises(HandError, match="travel"):
         Finger("a", (0, 0), Ray((0, 1)), travel=0.0)
     finger = Finger("a", (0, 0), Ray((0, 1)), travel=0.1)
-    with pytest.raises(ValueError, match="min_touching"):
+    with pytest.raises(HandError, match="min_touching"):
         Hand("h", (finger,), min_touching=2)
-    with pytest.raises(ValueError, match="unique"):
+    with pytest.raises(HandError, match="unique"):
         Hand("h", (finger, finger), min_touching=1)
-    with pytest.raises(ValueError, match="arc"):
+    with pytest.raises(HandError, match="arc"):
         Finger("a", (0, 0), Arc(0.01, 0.01, 0.0), travel=1.0)
 
 
@@ -103,3 +108,59 @@ def test_arc_chords_stay_within_half_a_millimetre_of_the_arc():
     u = np.clip(np.einsum("kmi,mi->km", fine[:, None] - a[None], d) / np.sum(d * d, axis=1), 0, 1)
     nearest = a[None] + u[..., None] * d[None]
     assert np.linalg.norm(fine[:, None] - nearest, axis=2).min(axis=1).max() < 5e-4
+
+
+def test_a_hand_without_fingers_is_a_hand_error():
+    with pytest.raises(HandError, match="no fingers"):
+        Hand("h", (), 1)
+
+
+@pytest.mark.parametrize("make, field", [
+    (lambda: Finger("f", (1e300, 0.0), Ray((1.0, 0.0)), 0.1), "start"),
+    (lambda: Finger("f", (-1e300, 0.0), Ray((1.0, 0.0)), 0.1), "start"),
+    (lambda: Finger("f", (0.0, 0.0), Ray((1.0, 0.0)), 0.1, virtual_start=1e300), "virtual_start"),
+    (lambda: Finger("f", (0.0, 0.0), Ray((1.0, 0.0)), 1e300), "travel"),
+    (lambda: Finger("f", (0.0, 0.0), Ray((1.0, 0.0)), 0.1, radius=3.0), "radius"),
+    (lambda: Finger("f", (0.0, 0.0), Ray((1.0, 0.0)), 0.1, alpha=float("nan")), "alpha"),
+    (lambda: Finger("f", (0.0, 0.0), Ray((1.0, 0.0)), 0.1, beta=-1.0), "beta"),
+    (lambda: Finger("f", "ab", Ray((1.0, 0.0)), 0.1), "start"),
+    (lambda: Finger("f", (0.0, 0.0), "ray", 0.1), "trajectory"),
+    (lambda: Arc(0.05, 0.04, 1e300), "phi_off"),
+    (lambda: Arc(1e300, 0.04, 0.0), "a_cos"),
+    (lambda: Arc(0.05, "x", 0.0), "a_sin"),
+    (lambda: Ray("ab"), "closing_direction"),
+    (lambda: Ray((0.0, 0.0)), "closing_direction"),
+    (lambda: Hand("h", [Finger("f", (0.0, 0.0), Ray((1.0, 0.0)), 0.1)], 1, miss_penalty=-1.0), "miss_penalty"),
+    (lambda: Hand("h", [Finger("f", (0.0, 0.0), Ray((1.0, 0.0)), 0.1)], 1.5), "min_touching"),
+    (lambda: Hand("h", [Finger(f"f{i}", (0.0, 0.0), Ray((1.0, 0.0)), 0.1) for i in range(11)], 1), "fingers"),
+])
+def test_absurd_hand_values_are_hand_errors_naming_the_field(make, field):
+    """A start of 1e300 or a phi_off of 1e300 once divided by zero in the search's kernels."""
+    with pytest.raises(HandError, match=field):
+        make()
+
+
+def test_a_huge_closing_direction_is_normalised():
+    assert Ray((1e300, 1e300)).closing_direction == pytest.approx((math.sqrt(0.5), math.sqrt(0.5)))
+
+
+absurd_numbers = st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.sampled_from([1e-300, 1e300, -1e300]),
+                           st.integers(-10**30, 10**30), st.text(max_size=2), st.none(), st.booleans())
+
+
+@settings(max_examples=100, deadline=None)
+@given(start=st.tuples(absurd_numbers, absurd_numbers), direction=st.tuples(absurd_numbers, absurd_numbers),
+       arc=st.one_of(st.none(), st.tuples(absurd_numbers, absurd_numbers, absurd_numbers)),
+       travel=absurd_numbers, virtual_start=absurd_numbers, alpha=absurd_numbers, beta=absurd_numbers,
+       radius=absurd_numbers, min_touching=absurd_numbers, miss_penalty=absurd_numbers)
+def test_fuzz_hand_construction_gives_a_hand_or_a_hand_error(start, direction, arc, travel, virtual_start, alpha,
+                                                             beta, radius, min_touching, miss_penalty):
+    try:
+        trajectory = Ray(direction) if arc is None else Arc(*arc)
+        finger = Finger("f", start, trajectory, travel, virtual_start=virtual_start, alpha=alpha, beta=beta,
+                        radius=radius)
+        hand = Hand("h", (finger,), min_touching, miss_penalty=miss_penalty)
+    except HandError:
+        return
+    assert np.all(np.isfinite(hand.starts)) and np.all(np.isfinite(hand.virtual_starts))
+    assert np.all(np.isfinite(hand.segments().start))

@@ -127,9 +127,7 @@ def test_plan_takes_the_colour_offset_and_footprint_options(tmp_path):
         assert json.loads((tmp_path / "p.json").read_text())["segmentation"]["colour_offset_px"] == expected
     assert main([*args, "--no-footprint", "--out", str(tmp_path / "p.json")]) == 0
     assert json.loads((tmp_path / "p.json").read_text())["planning_frame"]["on_table"] is False
-    with pytest.raises(SystemExit) as exit_:
-        main([*args, "--colour-offset", "1.5,0"])
-    assert exit_.value.code == 2
+    assert main([*args, "--colour-offset", "1.5,0"]) == 2
 
 
 def write(path, text):
@@ -189,3 +187,134 @@ def test_plan_bad_inputs(tmp_path, capsys, case, code, message):
 def test_intrinsics_from_shared_format_match_the_bundled_file():
     k = read_intrinsics(FRAME / "primesense_overhead_color.intr")
     assert (k.fx, k.fy, k.cx, k.cy, k.width, k.height) == (525.0, 525.0, 319.5, 239.5, 640, 480)
+
+
+# ---------------------------------------------------------------------------
+# Bad input: every option refused by name, nothing but InputError / NoFeasibleGrasp
+# ---------------------------------------------------------------------------
+
+
+def test_rgb_segmentation_of_the_bundled_frame_is_repaired_not_refused():
+    # Its RGB outline crossed itself on a pixel staircase ("edges 76 and 80 cross").
+    frame = bundled()
+    result = cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, "three-finger", segment="rgb", **FAST)
+    assert result.segmentation.method == "rgb" and len(result.metric.contour_xy) >= 3
+
+
+@pytest.mark.parametrize(("options", "message"), [
+    ({"intrinsics": None}, "intrinsics must be a contourgrasp.perception.Intrinsics, got NoneType"),
+    ({"rgb": np.zeros(10, np.uint8)}, r"rgb image must be \(H, W, 3\) or \(H, W\)"),
+    ({"mask": np.zeros(10, bool)}, r"mask must be an \(H, W\) image"),
+    ({"standoff": "0.1"}, "standoff must be a finite number, got '0.1'"),
+    ({"standoff": -0.1}, "standoff must be a number >= 0"),
+    ({"standoff": 5.0}, "standoff must be at most 2 m"),
+    ({"approach_offset": -1e9}, r"approach_offset must be within \+-0.5 m"),
+    ({"approach_offset": float("nan")}, "approach_offset must be a finite number"),
+    ({"segment": "edges"}, "segment must be one of"),
+    ({"depth_mode": 3}, "depth_mode must be one of"),
+    ({"fill_holes": "yes"}, "fill_holes must be True or False"),
+    ({"colour_offset_px": (1.5, 0)}, "colour_offset_px must be two integers"),
+    ({"footprint": 1}, "footprint must be True, False or None"),
+    ({"T_base_camera": np.full((4, 4), np.nan)}, r"T_base_camera\[0, 0\] is not finite"),
+    ({"T_base_camera": np.eye(3)}, r"T_base_camera must be a \(4, 4\) array"),
+    ({"T_base_camera": np.diag([2.0, 1.0, 1.0, 1.0])}, "T_base_camera: the rotation is not orthonormal"),
+    ({"T_base_camera": "eye"}, "T_base_camera must be an array of real numbers"),
+    ({"xy_stepp": 0.05}, "synthesis options: unknown option 'xy_stepp'"),
+])
+def test_bad_options_are_refused_by_name(options, message):
+    frame = bundled()
+    args = {"rgb": frame.rgb, "depth": frame.depth, "intrinsics": frame.intrinsics} | options
+    with pytest.raises(cg.InputError, match=message):
+        cg.plan_grasp(args.pop("rgb"), args.pop("depth"), args.pop("intrinsics"), "three-finger", **args)
+
+
+def test_plan_frame_takes_a_hand_only():
+    from contourgrasp.errors import HandError
+    from contourgrasp.pipeline import plan_frame
+
+    frame = bundled()
+    with pytest.raises(HandError, match="hand must be a contourgrasp.Hand, got str"):
+        plan_frame(frame.rgb, frame.depth, frame.intrinsics, "three-finger")
+
+
+def test_cli_refuses_an_absurd_approach_offset(tmp_path, capsys):
+    args = ["plan", "--rgb", str(FRAME / "color_0.png"), "--depth", str(FRAME / "depth_0.npy"),
+            "--intrinsics", str(FRAME / "primesense_overhead_color.intr"), "--approach-offset=-1e9"]
+    assert main(args) == 2
+    assert "approach_offset must be within" in capsys.readouterr().err
+
+
+def test_cli_mask_of_another_size_names_the_files(tmp_path, capsys):
+    cv2.imwrite(str(tmp_path / "mask.png"), np.zeros((24, 32), np.uint8))
+    args = ["plan", "--rgb", str(FRAME / "color_0.png"), "--depth", str(FRAME / "depth_0.npy"),
+            "--intrinsics", str(FRAME / "primesense_overhead_color.intr"), "--mask", str(tmp_path / "mask.png")]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert "depth_0.npy is 640x480 but" in err and "mask.png is 32x24" in err
+
+
+def _fuzz_frame(data, h, w):
+    from hypothesis import strategies as st
+    from hypothesis.extra.numpy import arrays
+
+    dtype = data.draw(st.sampled_from([np.float64, np.float32, np.uint16, np.int8, np.bool_]), label="depth dtype")
+    fill = st.sampled_from([0.0, np.nan, np.inf, -1.0, 0.7, 0.65, 1e300]) if dtype in (np.float64, np.float32) \
+        else st.integers(0, 1)
+    with np.errstate(over="ignore", invalid="ignore"):
+        depth = data.draw(arrays(dtype, (h, w), elements=fill), label="depth")
+    if data.draw(st.booleans(), label="object"):
+        depth = np.full((h, w), 0.7)
+        depth[h // 4: h // 2 + 1, w // 4: w // 2 + 1] = 0.65
+    rgb = data.draw(st.sampled_from([None, np.zeros((h, w, 3), np.uint8), np.zeros((h,), np.uint8),
+                                     np.zeros((h, w), np.float64), "rgb"]), label="rgb")
+    return depth, rgb
+
+
+def _fuzz_intrinsics(data, h, w):
+    from hypothesis import strategies as st
+
+    from contourgrasp.perception import Intrinsics
+
+    absurd = st.sampled_from([1e-300, 1e300, 1.0, 525.0, -1.0, float("nan")])
+    try:
+        return Intrinsics(fx=data.draw(absurd), fy=data.draw(absurd), cx=data.draw(st.sampled_from([w / 2, 1e300, -1e300])),
+                          cy=h / 2, width=w, height=h)
+    except cg.InputError:
+        return data.draw(st.sampled_from([None, "camera", 3]))
+
+
+def _fuzz_options(data):
+    from hypothesis import strategies as st
+
+    value = st.sampled_from([None, True, 0, -1, 1e300, -1e300, float("nan"), "0.1", (1, 2), "max", "rgb", "auto",
+                             np.eye(4), np.eye(3), ("a", 1)])
+    names = ["segment", "depth_mode", "footprint", "fill_holes", "colour_offset_px", "approach_offset", "standoff",
+             "T_base_camera", "mask", "xy_step", "d_min", "top_k"]
+    return data.draw(st.dictionaries(st.sampled_from(names), value, max_size=3), label="options")
+
+
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+@given(data=st.data())
+def test_random_frames_and_options_plan_or_raise_input_error(data):
+    import warnings
+
+    from contourgrasp.pipeline import plan_frame
+
+    h, w = data.draw(st.integers(1, 40), label="h"), data.draw(st.integers(1, 40), label="w")
+    depth, rgb = _fuzz_frame(data, h, w)
+    intrinsics = _fuzz_intrinsics(data, h, w)
+    options = {"xy_step": 0.03, "yaw_step": math.radians(10)} | _fuzz_options(data)
+    entry = data.draw(st.sampled_from(["plan_grasp", "plan_frame"]), label="entry")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            if entry == "plan_grasp":
+                cg.plan_grasp(rgb, depth, intrinsics, "three-finger", **options)
+            else:
+                plan_frame(rgb, depth, intrinsics, cg.load_hand("three-finger"), **options)
+        except (cg.InputError, cg.NoFeasibleGrasp):
+            pass

@@ -17,6 +17,8 @@ from hypothesis import strategies as st
 from scipy.optimize import linprog, minimize
 
 from contourgrasp import InputError, efd
+from contourgrasp import tolerances as cg_tol
+from contourgrasp.errors import QualityError
 from contourgrasp import quality as q
 from conftest import disc, rotate
 
@@ -372,3 +374,62 @@ def test_normals_of_a_fitted_disc_give_a_closing_three_finger_grasp():
     t = model.T * np.array([0.0, 1 / 3, 2 / 3])
     p, n = efd.evaluate(model, t), q.contour_normals(model, t)
     assert q.epsilon(p, n, mu=0.3, centre=model.locus) == pytest.approx(0.3, rel=1e-3)
+
+
+@pytest.mark.parametrize("mu", [1e300, 10.5, float("inf"), -0.1, "0.5", None])
+def test_friction_beyond_the_physical_bound_is_a_quality_error_naming_it(mu):
+    """mu = 1e300 once crashed (segfault) inside Qhull."""
+    p, n = [[-0.03, 0.0], [0.03, 0.0], [0.0, 0.03]], [[1.0, 0.0], [-1.0, 0.0], [0.0, -1.0]]
+    for metric in ("L1", "Linf"):
+        with pytest.raises(QualityError, match="mu"):
+            q.epsilon(p, n, mu=mu, metric=metric)
+    with pytest.raises(QualityError, match="at most 10" if isinstance(mu, float) and 10 < mu < math.inf else "mu"):
+        q.force_closure(p, n, mu=mu)
+
+
+def test_friction_at_the_bound_still_works():
+    p, n = [[-0.03, 0.0], [0.03, 0.0]], [[1.0, 0.0], [-1.0, 0.0]]
+    assert q.epsilon(p, n, mu=cg_tol.MAX_FRICTION) > 0
+    assert q.epsilon(p, n, mu=cg_tol.MAX_FRICTION, metric="Linf") > 0
+
+
+@pytest.mark.parametrize("metric", ["L1", "Linf"])
+@pytest.mark.parametrize("n", [0, 3])
+def test_epsilon_many_of_no_grasps_is_empty(metric, n):
+    empty = np.zeros((0, n, 2))
+    out = q.epsilon_many(empty, empty, metric=metric)
+    assert out.shape == (0,) and out.dtype == float
+
+
+def test_contacts_whose_torques_overflow_are_a_quality_error():
+    with pytest.raises(QualityError, match="overflow"):
+        q.epsilon([[1e308, 0.0], [-1e308, 0.0], [0.0, 1.0]], [[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0]], rho=1e-300)
+
+
+contact_values = st.one_of(st.floats(-0.1, 0.1), st.floats(allow_nan=True, allow_infinity=True),
+                           st.sampled_from([1e-300, 1e300, -1e300, 0.0]))
+
+
+@settings(max_examples=100, deadline=None)
+@given(n=st.integers(0, 5), data=st.data(),
+       mu=st.one_of(st.floats(0, 12), st.floats(allow_nan=True, allow_infinity=True), st.sampled_from([1e300, -1]),
+                    st.text(max_size=2)),
+       metric=st.sampled_from(["L1", "Linf", "L2"]), frame=st.booleans())
+def test_fuzz_quality_entry_points_return_or_raise_a_quality_error(n, data, mu, metric, frame):
+    points = np.array(data.draw(st.lists(st.tuples(contact_values, contact_values), min_size=n, max_size=n)),
+                      dtype=float).reshape(n, 2)
+    normals = np.array(data.draw(st.lists(st.tuples(contact_values, contact_values), min_size=n, max_size=n)),
+                       dtype=float).reshape(n, 2)
+    centre, rho = ((data.draw(contact_values), data.draw(contact_values)), data.draw(contact_values)) if frame else (
+        None, None)
+    calls = [lambda: q.epsilon(points, normals, mu=mu, centre=centre, rho=rho, metric=metric),
+             lambda: q.force_closure(points, normals, mu=mu, centre=centre, rho=rho),
+             lambda: q.epsilon_many(points[None], normals[None], mu=mu, centre=centre, rho=rho, metric=metric),
+             lambda: q.epsilon_many(np.repeat(points[None], 2, 0), np.repeat(normals[None], 2, 0),
+                                    np.ones((2, n), bool), mu=mu, metric=metric)]
+    for call in calls:
+        try:
+            result = call()
+        except QualityError:
+            continue
+        assert np.all(np.isfinite(result)) and np.all(np.asarray(result) >= 0)

@@ -1,8 +1,10 @@
 import math
+import warnings
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import contourgrasp as cg
 from contourgrasp import visualize
@@ -46,3 +48,18 @@ def test_image_plan_is_drawn_where_the_colour_image_shows_the_object():
         starts = [line.get_xydata()[0] for line in ax.lines if line.get_marker() == "o"]
         expected = visualize._to_pixels(result, [f.start for f in result.plan.fingers]) - shift
         np.testing.assert_allclose(starts, expected)
+
+
+@pytest.mark.parametrize("size, label", [(2e-4, "50 µm"), (0.12, "2 cm"), (9000.0, "2000 m")])
+def test_harmonics_figure_draws_any_contour_the_model_accepts(tmp_path, size, label):
+    # Issue 14: a contour x 1e307 crashed matplotlib; the bounds of clean_polygon now refuse it, and the scale
+    # bar follows the contour's size, so every accepted contour draws.
+    can = cg.example_contour("can")
+    fig = visualize.harmonics_figure(can / np.ptp(can, axis=0).max() * size, (1, 4))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fig.savefig(tmp_path / "h.png")
+    bars = [a for ax in fig.axes for a in ax.artists if hasattr(a, "txt_label")]
+    assert {bar.txt_label.get_text() for bar in bars} == {label}
+    with pytest.raises(cg.ContourError, match="too large"):
+        visualize.harmonics_figure(can * 1e307)

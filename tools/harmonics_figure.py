@@ -10,7 +10,7 @@ the polygon with the thesis's 4-harmonic EFD (left), with the adaptive one
 and the rule's left-out RMS distance e(N) against N with the tolerance (right).
 This is Figures 4.5/4.6 of the thesis, answered per object.
 
-Sweep (the table in :func:`contourgrasp.efd.choose_harmonics`)::
+Sweep (the tables in ``benchmarks/harmonics_sweep.md``)::
 
     python tools/harmonics_figure.py --sweep [--sim]
 
@@ -85,7 +85,7 @@ def left_out(points: np.ndarray, upper: int = tolerances.HARMONICS_BOUNDS[1]) ->
 def sim_contours(names=SIM_OBJECTS, seeds=range(3)) -> dict[str, list[np.ndarray]]:
     """Contours (m) the simulated camera segments for each object, one per seed."""
     from contourgrasp.sim import build_scene, render
-    from contourgrasp.sim.planners import camera_intrinsics, perceive
+    from contourgrasp.pipeline import perceive
 
     out = {}
     for name in names:
@@ -93,7 +93,7 @@ def sim_contours(names=SIM_OBJECTS, seeds=range(3)) -> dict[str, list[np.ndarray
         for seed in seeds:
             scene = build_scene(name, seed=seed)
             rgb, depth = render(scene, noise=True, seed=seed)
-            out[name].append(perceive(rgb, depth, camera_intrinsics(scene.camera.intrinsics))[1].contour_xy)
+            out[name].append(perceive(rgb, depth, scene.camera.intrinsics)[1].contour_xy)
     return out
 
 

@@ -16,9 +16,9 @@ The pipeline, one module per stage (thesis chapter 3):
 
 from __future__ import annotations
 
-from . import efd, hand, synthesis
-from .efd import EFD
-from .errors import ContourError, HandFileError, InputError, NoFeasibleGrasp, UnitWarning
+from . import efd, hand, synthesis, validation
+from .contour import EFD
+from .errors import ContourError, HandFileError, InputError, NoFeasibleGrasp, PlannerError, UnitWarning
 from .hand import Arc, Finger, Hand, Ray
 from .io.contour_file import example_contour, example_names, read_contour
 from .io.hand_file import load_hand, preset_names
@@ -29,13 +29,21 @@ __version__ = "0.1.0"
 
 
 def synthesize(contour_xy, hand, *, planner=None, **options) -> GraspPlan:
-    """Plan a grasp on a metric contour.
+    """Plan a grasp on a metric contour: :func:`contourgrasp.synthesis.search` with names resolved.
 
     ``hand`` is a preset name, a TOML path or a :class:`Hand`; ``planner`` a
     planner preset name (``"paper"``, ``"default"``), a planner TOML path or
     None (the options' defaults, which are the thesis's). ``options`` are
-    keyword options of :func:`contourgrasp.synthesis.synthesize` and override
+    keyword options of :func:`contourgrasp.synthesis.search` and override
     the planner's.
+
+    Raises
+    ------
+    InputError
+        A bad contour (ContourError), hand (HandError, HandFileError), planner or option
+        (PlannerError, naming it).
+    NoFeasibleGrasp
+        No pose satisfies the constraints.
 
     Examples
     --------
@@ -44,8 +52,9 @@ def synthesize(contour_xy, hand, *, planner=None, **options) -> GraspPlan:
     >>> plan.grid_size
     1764
     """
+    validation.options("synthesize", options, synthesis.search, error=PlannerError)
     settings = {} if planner is None else load_planner(planner).synthesis_options
-    return synthesis.synthesize(contour_xy, load_hand(hand), **(settings | options))
+    return synthesis.search(contour_xy, load_hand(hand), **(settings | options))
 
 
 def plan_grasp(rgb, depth, intrinsics, hand="five-finger-linear", *, planner=None, **options):
@@ -53,12 +62,12 @@ def plan_grasp(rgb, depth, intrinsics, hand="five-finger-linear", *, planner=Non
 
     Returns an :class:`contourgrasp.pipeline.ImageGraspPlan` (``.plan`` is the
     :class:`GraspPlan`, ``.T_camera_hand`` the 6-DoF pose); see
-    :func:`contourgrasp.pipeline.plan_grasp` for the options, which override the planner's.
+    :func:`contourgrasp.pipeline.plan_frame` for the options, which override the planner's.
     """
-    from .pipeline import plan_grasp as _plan_grasp
+    from .pipeline import plan_frame
 
     settings = {} if planner is None else load_planner(planner).plan_options
-    return _plan_grasp(rgb, depth, intrinsics, load_hand(hand), **(settings | options))
+    return plan_frame(rgb, depth, intrinsics, load_hand(hand), **(settings | options))
 
 
 __all__ = [

@@ -16,8 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__, efd, synthesize
-from .errors import InputError, NoFeasibleGrasp
+from . import __version__, synthesize
+from . import contour as efd
+from .errors import InputError, NoFeasibleGrasp, OutputError
 from .io.contour_file import example_contour, example_names, read_contour
 from .io.hand_file import load_hand, preset_names
 from .io.planner_file import load_planner, planner_names, synthesis_options
@@ -26,32 +27,64 @@ from .io.plan_file import atomic_outputs, plan_to_dict, write_json
 EXIT_OK, EXIT_INPUT, EXIT_INFEASIBLE = 0, 2, 3
 
 
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line naming ``--help``, not a usage block."""
+
+    def error(self, message):
+        self.exit(EXIT_INPUT, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+def _shown(text: str) -> str:
+    """``text`` quoted for an error message, cut to a readable length."""
+    return repr(text if len(text) <= 40 else text[:37] + "...")
+
+
+def _number(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number, got {_shown(text)}") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"must be a finite number, got {_shown(text)}")
+    return value
+
+
 def _positive_float(text: str) -> float:
-    value = float(text)
-    if not (value > 0 and math.isfinite(value)):
-        raise argparse.ArgumentTypeError(f"must be a positive number, got {text}")
+    try:
+        value = _number(text)
+    except argparse.ArgumentTypeError:
+        value = math.nan
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be a positive number, got {_shown(text)}")
     return value
 
 
 def _non_negative_float(text: str) -> float:
-    value = float(text)
-    if not (value >= 0 and math.isfinite(value)):
-        raise argparse.ArgumentTypeError(f"must be a number >= 0, got {text}")
+    try:
+        value = _number(text)
+    except argparse.ArgumentTypeError:
+        value = math.nan
+    if not value >= 0:
+        raise argparse.ArgumentTypeError(f"must be a number >= 0, got {_shown(text)}")
+    return value
+
+
+def _whole(text: str, minimum: int, wanted: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = minimum - 1
+    if value < minimum:
+        raise argparse.ArgumentTypeError(f"must be {wanted}, got {_shown(text)}")
     return value
 
 
 def _positive_int(text: str) -> int:
-    value = int(text)
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be a positive integer, got {text}")
-    return value
+    return _whole(text, 1, "a positive integer")
 
 
 def _non_negative_int(text: str) -> int:
-    value = int(text)
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"must be an integer >= 0, got {text}")
-    return value
+    return _whole(text, 0, "an integer >= 0")
 
 
 def _names(text: str) -> list[str]:
@@ -65,7 +98,7 @@ def _contour(spec: str) -> np.ndarray:
 
 
 def _parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="contourgrasp", description=__doc__.splitlines()[0])
+    parser = _Parser(prog="contourgrasp", description=__doc__.splitlines()[0])
     parser.add_argument("--version", action="version", version=f"contourgrasp {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
@@ -96,7 +129,7 @@ def _parser() -> argparse.ArgumentParser:
     plan.add_argument("--colour-offset", type=_pixel_pair, metavar="DX,DY",
                       help="colour-depth misregistration in pixels, 0,0 for a pair registered to the pixel "
                            "(default: estimated from the object's edges)")
-    plan.add_argument("--approach-offset", type=float, default=0.01, help="added to the nearest depth, m")
+    plan.add_argument("--approach-offset", type=_number, default=0.01, help="added to the nearest depth, m")
     plan.add_argument("--standoff", type=_non_negative_float, default=0.10, help="pre-grasp distance, m")
     plan.add_argument("--extrinsics", help="T_base_camera (4x4): .npy, .txt, .json, .yaml or autolab .tf")
     _add_synthesis_options(plan)
@@ -116,17 +149,12 @@ def _pixel_pair(text: str) -> tuple[int, int]:
     try:
         dx, dy = (int(part) for part in text.split(","))
     except ValueError:
-        raise argparse.ArgumentTypeError(f"must be two integers DX,DY, got {text}") from None
+        raise argparse.ArgumentTypeError(f"must be two integers DX,DY, got {_shown(text)}") from None
     return dx, dy
 
 
 def _harmonics(text: str):
-    if text == "adaptive":
-        return text
-    try:
-        return _positive_int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a positive integer or 'adaptive', got {text}") from None
+    return text if text == "adaptive" else _whole(text, 1, "a positive integer or 'adaptive'")
 
 
 def _add_synthesis_options(parser) -> None:
@@ -159,7 +187,8 @@ def _add_bench_parser(sub) -> None:
     bench = sub.add_parser("bench", help="simulated grasping experiment (thesis Table 4.4): objects x trials x planners")
     objects = bench.add_mutually_exclusive_group()
     objects.add_argument("--objects", default="can,case,bottle,stone1,stone2",
-                         help="comma-separated names of the simulated objects (default: the thesis's five)")
+                         help="comma-separated names of the simulated objects or of object sets (thesis: the "
+                              "five; a set is reported as a split) (default: the thesis's five)")
     objects.add_argument("--mesh", nargs="+", metavar="FILE", help="OBJ/STL mesh files in meters, z up, instead")
     bench.add_argument("--trials", type=_positive_int, default=20, help="trials per object and planner")
     bench.add_argument("--seed", type=_non_negative_int, default=0, help="trial t uses seed SEED + t")
@@ -168,9 +197,16 @@ def _add_bench_parser(sub) -> None:
                        help="comma-separated planner names: presets, baselines, ablation steps or planner TOML files")
     bench.add_argument("--ablation", action="store_true",
                        help="also run every step of the ablation from paper to default")
-    bench.add_argument("--out", default="bench-output", help="output folder (created if missing)")
+    bench.add_argument("--out", help="output folder (created if missing; default bench-output)")
     bench.add_argument("--noise", action=argparse.BooleanOptionalAction, default=True,
                        help="depth sensor noise in the planner's picture")
+    bench.add_argument("--workers", type=_positive_int,
+                       help="run the trials in this many processes (default: the number of cores; 1: in this one)")
+    bench.add_argument("--ray", nargs="?", const="", metavar="ADDRESS",
+                       help="run every trial as a Ray task on the cluster at ADDRESS, or without one on a local Ray "
+                            "(pip install 'contourgrasp[cluster]')")
+    bench.add_argument("--resume", metavar="DIR",
+                       help="continue the bench whose outputs are in DIR (same settings), keeping its trials")
 
 
 def _add_calibrate_parser(sub) -> None:
@@ -181,7 +217,7 @@ def _add_calibrate_parser(sub) -> None:
 
 
 def _plan_options(args) -> dict:
-    """The planner's options of ``plan_grasp``, overridden by the options given on the command line."""
+    """The planner's options of ``plan_frame``, overridden by the options given on the command line."""
     if args.d_max is not None and len(args.d_max) > 2:
         raise InputError(f"--d-max takes one or two values, got {len(args.d_max)}")
     given = {
@@ -204,8 +240,14 @@ def _plan_options(args) -> dict:
     return load_planner(args.planner).plan_options | {k: v for k, v in given.items() if v is not None}
 
 
+def _inputs(args) -> list:
+    """The files a command reads, which its outputs must not overwrite."""
+    names = ("contour", "rgb", "depth", "intrinsics", "mask", "extrinsics", "hand", "planner")
+    return [getattr(args, name, None) for name in names]
+
+
 def _write_outputs(args, data: dict, figure, summary: str) -> None:
-    with atomic_outputs(args.out, args.plot) as (out, plot):
+    with atomic_outputs(args.out, args.plot, inputs=_inputs(args)) as (out, plot):
         if out is not None:
             write_json(data, out)
         if plot is not None:
@@ -244,18 +286,18 @@ def _synth(args) -> int:
 
 
 def _plan(args) -> int:
-    from .io.camera_file import read_extrinsics, read_mask, read_rgbd
+    from .io.camera_file import read_extrinsics, read_rgbd
     from .io.plan_file import image_plan_to_dict
-    from .pipeline import plan_grasp
+    from .pipeline import plan_frame
 
-    frame = read_rgbd(args.rgb, args.depth, args.intrinsics, depth_scale=args.depth_scale)
-    result = plan_grasp(
+    frame = read_rgbd(args.rgb, args.depth, args.intrinsics, mask_path=args.mask, depth_scale=args.depth_scale)
+    result = plan_frame(
         frame.rgb,
         frame.depth,
         frame.intrinsics,
         load_hand(args.hand),
         segment=args.segment,
-        mask=None if args.mask is None else read_mask(args.mask),
+        mask=frame.mask,
         fill_holes=not args.no_fill_holes,
         colour_offset_px=args.colour_offset,
         approach_offset=args.approach_offset,
@@ -284,23 +326,35 @@ def _mesh_names(paths) -> list[str]:
 
 
 def _bench(args) -> int:
+    if args.resume is not None and args.out is not None and Path(args.out) != Path(args.resume):
+        raise OutputError(f"--resume {args.resume} and --out {args.out} name different folders: give one")
+    out = Path(args.resume or args.out or "bench-output")
+    if out.exists() and not out.is_dir():
+        raise OutputError(f"{out}: cannot write the bench's outputs into it, it is not a directory")
     from .sim import bench, mesh_object
 
     started = time.perf_counter()
-    objects = [mesh_object(path, name=name) for path, name in zip(args.mesh, _mesh_names(args.mesh), strict=True)] \
-        if args.mesh else bench.thesis_objects(_names(args.objects))
+    objects, splits = ([mesh_object(path, name=name) for path, name in zip(args.mesh, _mesh_names(args.mesh),
+                                                                            strict=True)], ()) \
+        if args.mesh else bench.resolve_objects(args.objects)
     planners = _names(args.planners)
     if args.ablation:
         from .sim.planners import ablation_planners
 
         planners += [p.name for p in ablation_planners()[1:-1] if p.name not in planners]
     setup = bench.Bench(objects=objects, planners=planners, trials=args.trials, seed=args.seed,
-                        hand=load_hand(args.hand), noise=args.noise)
-    with bench.console_progress(setup.size) as progress:
-        results = bench.run_bench(setup, progress)
-    paths = bench.write_outputs(setup, results, args.out, wall_time=time.perf_counter() - started)
-    print("\n".join(bench.rates_table(setup, results)))
-    print(f"{len(results)} trials in {time.perf_counter() - started:.0f} s -> {', '.join(map(str, paths))}")
+                        hand=load_hand(args.hand), noise=args.noise, splits=splits)
+    journal, done = bench.resume(out, setup) if args.resume is not None else (None, ())
+    with bench.executor(setup, workers=args.workers, ray=args.ray is not None, address=args.ray or None) as run:
+        if journal is None:
+            out.mkdir(parents=True, exist_ok=True)
+            journal = bench.Journal.start(out, setup)
+        with journal, bench.console_progress(setup, done=done) as progress:
+            results = bench.run_bench(setup, progress, execute=run, done=done, record=journal.append)
+    paths = bench.write_outputs(setup, results, out, wall_time=time.perf_counter() - started)
+    print("\n".join(bench.split_table(setup, results) if setup.splits else bench.rates_table(setup, results)))
+    kept = f" ({len(done)} kept from {out / bench.JOURNAL})" if done else ""
+    print(f"{len(results)} trials{kept} in {time.perf_counter() - started:.0f} s -> {', '.join(map(str, paths))}")
     return EXIT_OK
 
 
@@ -314,7 +368,7 @@ def _calibrate(args) -> int:
         comment = (f"{calibration.hand.name} with virtual starts (lambda_virt) calibrated by `contourgrasp calibrate`\n"
                    f"from the simulated hand closing in free space (trial actuation, reference finger "
                    f"{calibration.reference}).")
-        with atomic_outputs(args.out) as (out,):
+        with atomic_outputs(args.out, inputs=_inputs(args)) as (out,):
             out.write_text(hand_to_toml(calibration.calibrated_hand(), comment=comment), encoding="utf-8")
         print(f"calibrated hand -> {args.out}")
     return EXIT_OK
@@ -331,7 +385,7 @@ def _efd(args) -> int:
     if args.plot:
         from .visualize import harmonics_figure
 
-        with atomic_outputs(args.plot) as (plot,):
+        with atomic_outputs(args.plot, inputs=_inputs(args)) as (plot,):
             harmonics_figure(contour, args.harmonics, curvature=args.curvature).savefig(plot, dpi=110, format="png")
     return EXIT_OK
 
@@ -341,7 +395,15 @@ COMMANDS = {"hands": _hands, "synth": _synth, "plan": _plan, "bench": _bench, "e
 
 
 def main(argv=None) -> int:
-    args = _parser().parse_args(argv)
+    """Run the ``contourgrasp`` command on ``argv`` (default ``sys.argv[1:]``); the exit code.
+
+    Every error is one line on stderr: 2 for bad input (argument errors
+    included), 3 when no pose is feasible.
+    """
+    try:
+        args = _parser().parse_args(argv)
+    except SystemExit as done:  # --help, --version, or an argument error already printed
+        return done.code if isinstance(done.code, int) else EXIT_INPUT
     code, message = EXIT_OK, None
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -352,7 +414,8 @@ def main(argv=None) -> int:
         except NoFeasibleGrasp as err:
             code, message = EXIT_INFEASIBLE, f"no feasible grasp: {err.reason}"
         except OSError as err:
-            code, message = EXIT_INPUT, f"error: cannot write {err.filename}: {err.strerror}"
+            what = f"cannot write {err.filename}" if err.filename else "cannot write the output"
+            code, message = EXIT_INPUT, f"error: {what}: {err.strerror or err}"
     for w in caught:
         print(f"contourgrasp: warning: {w.message}", file=sys.stderr)
     if message:

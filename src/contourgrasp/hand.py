@@ -36,33 +36,60 @@ from functools import cached_property
 import numpy as np
 
 from . import tolerances as tol
+from . import validation as check
+from .errors import HandError
 
 
 @dataclass(frozen=True)
 class Ray:
-    """Straight closing motion (eq 3.18); ``closing_direction`` is normalised on creation."""
+    """Straight closing motion; ``closing_direction`` is normalised on creation.
+
+    Implements eq 3.18: the fingertip after travelling ``lam`` is ``start + lam * closing_direction``
+    in the hand frame, placed at the pose (x_p, y_p, phi_p) by :func:`to_image`.
+
+    Raises
+    ------
+    HandError
+        The direction is not a finite, non-zero 2-vector.
+    """
 
     closing_direction: tuple[float, float]
 
     def __post_init__(self):
-        c = np.asarray(self.closing_direction, dtype=float)
-        norm = float(np.linalg.norm(c))
-        if c.shape != (2,) or not np.isfinite(norm) or norm < tol.MIN_DIRECTION:
-            raise ValueError(f"closing_direction must be a non-zero 2-vector, got {self.closing_direction!r}")
+        c = check.float_array("closing_direction", self.closing_direction, error=HandError)
+        with np.errstate(over="ignore"):
+            norm = float(np.linalg.norm(c)) if c.shape == (2,) else np.nan
+        if norm == np.inf and np.isfinite(c).all():  # the squares overflowed: scale down first
+            c = c / np.abs(c).max()
+            norm = float(np.linalg.norm(c))
+        if not np.isfinite(norm) or norm < tol.MIN_DIRECTION:
+            raise HandError(f"closing_direction must be a non-zero 2-vector, got {self.closing_direction!r}")
         object.__setattr__(self, "closing_direction", (float(c[0] / norm), float(c[1] / norm)))
 
 
 @dataclass(frozen=True)
 class Arc:
-    """Elliptic-arc closing motion (eq 3.20-3.21): radii ``a_cos``, ``a_sin`` (m), start angle ``phi_off`` (rad)."""
+    """Elliptic-arc closing motion: radii ``a_cos``, ``a_sin`` (m), start angle ``phi_off`` (rad).
+
+    Implements eq 3.20 and 3.21: the fingertip moves by ``E(phi_off + theta) - E(phi_off)``
+    (:meth:`offset`), the ellipse point less its offset at the start.
+
+    Raises
+    ------
+    HandError
+        A radius that is not positive or above ``tolerances.MAX_HAND_SIZE``, or ``|phi_off|``
+        above ``tolerances.MAX_ARC_ANGLE``.
+    """
 
     a_cos: float
     a_sin: float
     phi_off: float
 
     def __post_init__(self):
-        if not (self.a_cos > 0 and self.a_sin > 0):
-            raise ValueError(f"arc radii must be positive, got a_cos={self.a_cos}, a_sin={self.a_sin}")
+        for name in ("a_cos", "a_sin"):
+            check.bounded(f"arc {name}", getattr(self, name), tol.MAX_HAND_SIZE, " m", strict=True, error=HandError)
+        angle = check.finite("arc phi_off", self.phi_off, error=HandError)
+        check.at_most("arc |phi_off|", abs(angle), tol.MAX_ARC_ANGLE, " rad", error=HandError)
 
     @cached_property
     def _length_table(self) -> tuple[np.ndarray, np.ndarray]:
@@ -119,6 +146,14 @@ class Finger:
     radius : float
         Half the finger's width, m: the fingertip is a disc of this radius
         (used by the planner's finger-thickness check, not by the thesis's).
+
+    Lengths are at most ``tolerances.MAX_HAND_SIZE`` (``|start|``, ``|virtual_start|`` too) and
+    gains at most ``tolerances.MAX_GAIN`` in magnitude.
+
+    Raises
+    ------
+    HandError
+        Naming the finger and the attribute that is not a number in range.
     """
 
     name: str
@@ -132,12 +167,28 @@ class Finger:
     radius: float = 0.0
 
     def __post_init__(self):
-        if not self.radius >= 0:
-            raise ValueError(f"finger {self.name!r}: radius must be >= 0, got {self.radius}")
-        if not self.travel > 0:
-            raise ValueError(f"finger {self.name!r}: travel must be > 0, got {self.travel}")
+        if not isinstance(self.name, str):
+            raise HandError(f"finger name must be a string, got {self.name!r}")
+        what = f"finger {self.name!r}:"
+        start = check.float_array(f"{what} start", self.start, error=HandError)
+        if start.shape != (2,):
+            raise HandError(f"{what} start must be two numbers (x, y), got {self.start!r}")
+        for value in start.tolist():
+            check.at_most(f"{what} |start|", abs(check.finite(f"{what} start", value, error=HandError)),
+                          tol.MAX_HAND_SIZE, " m", error=HandError)
+        if not isinstance(self.trajectory, (Ray, Arc)):
+            raise HandError(f"{what} trajectory must be a Ray or an Arc, got {type(self.trajectory).__name__}")
+        check.bounded(f"{what} radius", self.radius, tol.MAX_HAND_SIZE, " m", error=HandError)
+        check.bounded(f"{what} travel", self.travel, tol.MAX_HAND_SIZE, " m", strict=True, error=HandError)
+        check.at_most(f"{what} |virtual_start|", abs(check.finite(f"{what} virtual_start", self.virtual_start,
+                                                                 error=HandError)), tol.MAX_HAND_SIZE, " m",
+                      error=HandError)
+        check.at_most(f"{what} |alpha|", abs(check.finite(f"{what} alpha", self.alpha, error=HandError)),
+                      tol.MAX_GAIN, error=HandError)
+        check.bounded(f"{what} beta", self.beta, tol.MAX_GAIN, error=HandError)
+        check.flag(f"{what} required", self.required, error=HandError)
         if isinstance(self.trajectory, Arc) and max(self.travel, abs(self.virtual_start)) >= self.trajectory.perimeter:
-            raise ValueError(f"finger {self.name!r}: travel and virtual_start must be shorter than the arc's ellipse")
+            raise HandError(f"finger {self.name!r}: travel and virtual_start must be shorter than the arc's ellipse")
         object.__setattr__(self, "start", (float(self.start[0]), float(self.start[1])))
 
     def points(self, lam) -> np.ndarray:
@@ -169,7 +220,10 @@ class Finger:
 
     @property
     def virtual_start_point(self) -> np.ndarray:
-        """(2,) float: p_virt of eq 3.37."""
+        """(2,) float: p_virt, the trajectory at ``lam = virtual_start``.
+
+        Implements eq 3.37 (in the hand frame; :func:`to_image` places it at a pose).
+        """
         return self.points(self.virtual_start)[0]
 
 
@@ -186,6 +240,12 @@ class Hand:
     miss_penalty : float
         Cost added per finger that closes on air (the ``miss`` part of the cost).
     description : str
+
+    Raises
+    ------
+    HandError
+        No fingers or more than ``tolerances.MAX_FINGERS``, a finger that is not a :class:`Finger`, names not unique, ``min_touching``
+        not in 1..number of fingers, or ``miss_penalty`` not in [0, ``tolerances.MAX_GAIN``].
     """
 
     name: str
@@ -195,14 +255,21 @@ class Hand:
     description: str = field(default="", compare=False)
 
     def __post_init__(self):
+        if not isinstance(self.name, str) or not isinstance(self.description, str):
+            raise HandError(f"hand name and description must be strings, got {self.name!r}, {self.description!r}")
+        if not isinstance(self.fingers, (tuple, list)) or not all(isinstance(f, Finger) for f in self.fingers):
+            raise HandError(f"hand {self.name!r}: fingers must be a sequence of Finger")
         object.__setattr__(self, "fingers", tuple(self.fingers))
         n = len(self.fingers)
         if n == 0:
-            raise ValueError(f"hand {self.name!r} has no fingers")
-        if not 1 <= self.min_touching <= n:
-            raise ValueError(f"hand {self.name!r}: min_touching must be in 1..{n}, got {self.min_touching}")
+            raise HandError(f"hand {self.name!r} has no fingers")
+        check.at_most(f"hand {self.name!r}: number of fingers", n, tol.MAX_FINGERS, error=HandError)
+        if isinstance(self.min_touching, bool) or not isinstance(self.min_touching, (int, np.integer)) or not (
+                1 <= self.min_touching <= n):
+            raise HandError(f"hand {self.name!r}: min_touching must be in 1..{n}, got {self.min_touching!r}")
+        check.bounded(f"hand {self.name!r}: miss_penalty", self.miss_penalty, tol.MAX_GAIN, error=HandError)
         if len({f.name for f in self.fingers}) != n:
-            raise ValueError(f"hand {self.name!r}: finger names must be unique")
+            raise HandError(f"hand {self.name!r}: finger names must be unique")
 
     @property
     def starts(self) -> np.ndarray:
@@ -262,7 +329,17 @@ class HandSegments:
 
 
 def rotation(yaw) -> np.ndarray:
-    """(..., 2, 2) float: R(yaw) = [[cos, -sin], [sin, cos]], hand frame -> image plane."""
+    """(..., 2, 2) float: R(yaw) = [[cos, -sin], [sin, cos]], hand frame -> image plane.
+
+    Implements eq 3.19, transposed: the thesis prints R(phi_p) = [[cos, sin], [-sin, cos]], a
+    rotation by -phi_p; this is the right-handed rotation by yaw (module docstring), so only the
+    sign of the reported yaw differs.
+
+    Examples
+    --------
+    >>> rotation(np.pi / 2).round(12) @ [1.0, 0.0]
+    array([0., 1.])
+    """
     c, s = np.cos(yaw), np.sin(yaw)
     return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], -2)
 

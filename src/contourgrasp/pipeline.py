@@ -26,13 +26,15 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from . import perception
-from .errors import InputError
+from . import perception, validation
+from .errors import HandError, PerceptionError, PlannerError
 from .hand import Hand
 from .perception import Intrinsics, MetricContour, Segmentation
-from .synthesis import GraspPlan, synthesize
+from .perception.camera import check_intrinsics
+from .synthesis import GraspPlan, search
+from .tolerances import APPROACH_OFFSET, HOMOGENEOUS_ROW, MAX_APPROACH_OFFSET, MAX_STANDOFF, ROTATION_TOLERANCE
 
-SEGMENT_CHOICES = ("auto", "rgb", "depth")
+SEGMENT_CHOICES = perception.SEGMENT_METHODS
 
 
 @dataclass(frozen=True, eq=False)
@@ -71,7 +73,7 @@ class ImageGraspPlan:
         return Rotation.from_matrix(self.T_camera_hand[:3, :3]).as_quat()
 
 
-def plan_grasp(
+def plan_frame(
     rgb,
     depth,
     intrinsics: Intrinsics,
@@ -83,12 +85,15 @@ def plan_grasp(
     footprint: bool | None = None,
     fill_holes: bool = True,
     colour_offset_px=None,
-    approach_offset: float = perception.APPROACH_OFFSET,
+    approach_offset: float = APPROACH_OFFSET,
     standoff: float = 0.10,
     T_base_camera=None,
     **synthesis_options,
 ) -> ImageGraspPlan:
-    """Plan a grasp on one RGB-D frame.
+    """Plan a grasp on one RGB-D frame with a :class:`~contourgrasp.hand.Hand`.
+
+    :func:`contourgrasp.plan_grasp` is this with a hand preset name or file and
+    a planner's settings.
 
     Parameters
     ----------
@@ -117,31 +122,44 @@ def plan_grasp(
         pixel; by default ``"auto"`` segmentation estimates it
         (:func:`contourgrasp.perception.colour_offset`).
     approach_offset : float
-        Added to the nearest depth inside the contour, m.
+        Added to the nearest depth inside the contour, m; at most ``MAX_APPROACH_OFFSET`` (0.5 m)
+        either way (:mod:`contourgrasp.tolerances`).
     standoff : float
-        Distance of the pre-grasp pose back along the approach axis, m.
+        Distance of the pre-grasp pose back along the approach axis, m, in [0, ``MAX_STANDOFF``] (2 m).
     T_base_camera : (4, 4) float, optional
-        Camera pose in the robot's base frame.
+        Camera pose in the robot's base frame, a rigid transform (checked as
+        :func:`contourgrasp.io.camera_file.read_extrinsics` checks a file's).
     **synthesis_options
-        Keyword options of :func:`contourgrasp.synthesis.synthesize`.
+        Keyword options of :func:`contourgrasp.synthesis.search`.
 
     Raises
     ------
-    InputError
-        Bad images, intrinsics or options; no object found (SegmentationError).
+    PerceptionError
+        Bad images, intrinsics, extrinsics or options; no object found (SegmentationError).
+    PlannerError
+        An unknown or bad planning option.
+    HandError
+        ``hand`` is not a :class:`~contourgrasp.hand.Hand`.
     NoFeasibleGrasp
         The object was found but no pose satisfies the constraints.
     """
-    if not (math.isfinite(standoff) and standoff >= 0):
-        raise InputError(f"standoff must be a distance >= 0, got {standoff}")
+    if not isinstance(hand, Hand):
+        raise HandError(f"hand must be a contourgrasp.Hand, got {type(hand).__name__}")
+    standoff = validation.non_negative("standoff", standoff, error=PerceptionError)
+    validation.at_most("standoff", standoff, MAX_STANDOFF, " m", error=PerceptionError)
+    validation.options("synthesis options", synthesis_options, search, error=PlannerError)
+    if T_base_camera is not None:
+        T_base_camera = validation.rigid_transform("T_base_camera", T_base_camera, error=PerceptionError,
+                                                   rotation_tolerance=ROTATION_TOLERANCE,
+                                                   row_tolerance=HOMOGENEOUS_ROW)
     seg, metric, filled = perceive(rgb, depth, intrinsics, segment=segment, mask=mask, depth_mode=depth_mode,
                                    footprint=footprint, fill_holes=fill_holes, colour_offset_px=colour_offset_px,
                                    approach_offset=approach_offset)
-    plan = synthesize(metric.contour_xy, hand, **synthesis_options)
+    plan = search(metric.contour_xy, hand, **synthesis_options)
     T_camera_hand = hand_pose(metric, plan.pose, metric.approach_depth)
     T_camera_pregrasp = T_camera_hand.copy()
     T_camera_pregrasp[:3, 3] -= standoff * T_camera_hand[:3, 2]
-    T_base_hand = None if T_base_camera is None else np.asarray(T_base_camera, dtype=float) @ T_camera_hand
+    T_base_hand = None if T_base_camera is None else T_base_camera @ T_camera_hand
     return ImageGraspPlan(plan, seg, metric, intrinsics, T_camera_hand, T_camera_pregrasp, T_base_hand, filled)
 
 
@@ -156,23 +174,18 @@ def perceive(
     footprint: bool | None = None,
     fill_holes: bool = True,
     colour_offset_px=None,
-    approach_offset: float = perception.APPROACH_OFFSET,
+    approach_offset: float = APPROACH_OFFSET,
 ) -> tuple[Segmentation, MetricContour, int]:
-    """The perception half of :func:`plan_grasp`: (segmentation, metric contour, filled depth pixels).
+    """The perception half of :func:`plan_frame`: (segmentation, metric contour, filled depth pixels).
 
     Checks the depth, fills small holes, segments (or takes ``mask``) and puts
-    the contour in meters; the options are :func:`plan_grasp`'s.
+    the contour in meters; the options are :func:`plan_frame`'s.
     """
-    if segment not in SEGMENT_CHOICES:
-        raise InputError(f"segment must be one of {SEGMENT_CHOICES}, got {segment!r}")
-    if footprint not in (None, True, False):
-        raise InputError(f"footprint must be True, False or None, got {footprint!r}")
-    if footprint and depth_mode == "plane":
-        raise InputError("footprint=True needs depth_mode 'max': a footprint lies on the table, not at the object's top")
+    _check_options(intrinsics, segment, depth_mode, footprint, fill_holes, colour_offset_px, approach_offset)
     d = perception.as_depth(depth)
     intrinsics.check_shape(d.shape, "depth image")
     if not perception.valid_depth(d).any():
-        raise InputError("the depth image has no valid reading (all 0, NaN or outside the sensor range)")
+        raise PerceptionError("the depth image has no valid reading (all 0, NaN or outside the sensor range)")
     filled = 0
     if fill_holes:
         d, filled = perception.fill_depth_holes(d)
@@ -187,6 +200,24 @@ def perceive(
         offset=approach_offset,
     )
     return seg, metric, filled
+
+
+def _check_options(intrinsics, segment, depth_mode, footprint, fill_holes, colour_offset_px, approach_offset):
+    """Refuse, by name, a perception option of :func:`perceive` of the wrong type or value."""
+    check_intrinsics(intrinsics)
+    validation.choice("segment", segment, SEGMENT_CHOICES, error=PerceptionError)
+    validation.choice("depth_mode", depth_mode, perception.DEPTH_MODES, error=PerceptionError)
+    if footprint is not None and not isinstance(footprint, (bool, np.bool_)):
+        raise PerceptionError(f"footprint must be True, False or None, got {footprint!r}")
+    if footprint and depth_mode == "plane":
+        raise PerceptionError("footprint=True needs depth_mode 'max': a footprint lies on the table, not at the object's top")
+    validation.flag("fill_holes", fill_holes, error=PerceptionError)
+    if colour_offset_px is not None:
+        validation.pixel_offset("colour_offset_px", colour_offset_px, error=PerceptionError)
+    offset = validation.finite("approach_offset", approach_offset, error=PerceptionError)
+    if abs(offset) > MAX_APPROACH_OFFSET:
+        raise PerceptionError(f"approach_offset must be within +-{MAX_APPROACH_OFFSET:g} m of the object's top, "
+                              f"got {offset:g} m")
 
 
 def hand_pose(metric: MetricContour, pose, depth: float) -> np.ndarray:

@@ -41,6 +41,9 @@ Metrics
     push less than another: without it two antipodal contacts would always
     cancel their normal forces and span a flat set. Both metrics agree on force
     closure and eps_L1 <= eps_Linf <= n eps_L1.
+Friction
+    mu is at most :data:`tolerances.MAX_FRICTION` (10): no real pair of materials comes near,
+    and far beyond it the cone edges swamp the normals until the wrench hull cannot be built.
 
     epsilon is the radius of the largest origin-centred ball inside the grasp
     wrench space: the smallest distance of the origin to a facet's plane when
@@ -65,17 +68,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
-from . import efd
 from . import tolerances as tol
-from .errors import InputError
+from . import validation as check
+from .contour import EFD, evaluate
+from .errors import QualityError
 
 METRICS: tuple[str, ...] = ("L1", "Linf")
-
-#: The L-inf wrench space has 3**n vertices before the hull; beyond this it is refused.
-LINF_MAX_CONTACTS = 8
-
-#: Elements of the (poses, planes, wrenches) array evaluated at once by :func:`epsilon_many`.
-_BATCH_ELEMENTS = 2_000_000
 
 
 @dataclass(frozen=True)
@@ -127,8 +125,9 @@ def contact_wrenches(points, normals, *, mu: float = 0.5, centre=None, rho=None)
 
     Raises
     ------
-    InputError
-        Naming the argument that is malformed.
+    QualityError
+        Naming the argument that is malformed, or when the contacts lie so far from ``centre``
+        (or ``rho`` is so small) that their torques overflow.
     """
     p, n = _check_contacts(points, normals)
     mu = _check_mu(mu)
@@ -144,7 +143,7 @@ def epsilon(points, normals, *, mu: float = 0.5, centre=None, rho=None, metric: 
     metric : {"L1", "Linf"}
         ``"L1"`` bounds the sum of the normal forces, ``"Linf"`` each of them
         (module docstring; Ferrari & Canny 1992). ``"Linf"`` takes at most
-        :data:`LINF_MAX_CONTACTS` contacts.
+        :data:`tolerances.LINF_MAX_CONTACTS` contacts.
 
     Returns
     -------
@@ -214,9 +213,14 @@ def epsilon_many(
     -------
     (p,) float
         ``epsilon_many(...)[k]`` equals :func:`epsilon` of grasp k's valid
-        contacts to within rounding. The L1 metric is vectorised over grasps
-        (every plane through three wrenches is tested as a supporting plane);
-        ``"Linf"`` loops over grasps with Qhull.
+        contacts to within rounding; empty for no grasps (p = 0). The L1 metric
+        is vectorised over grasps (every plane through three wrenches is tested
+        as a supporting plane); ``"Linf"`` loops over grasps with Qhull.
+
+    Raises
+    ------
+    QualityError
+        As :func:`contact_wrenches`.
     """
     metric = _check_metric(metric)
     mu = _check_mu(mu)
@@ -226,11 +230,11 @@ def epsilon_many(
     if metric == "L1":
         return _ball_radius_batch(w, np.repeat(ok, 2, axis=1))
     _check_linf_size(int(ok.sum(axis=1).max(initial=0)))
-    pairs = w.reshape(len(w), -1, 2, 3)
+    pairs = w.reshape(len(w), w.shape[1] // 2, 2, 3)
     return np.array([_ball_radius(_minkowski_sum(pairs[k][ok[k]])) for k in range(len(w))])
 
 
-def contour_normals(model: efd.EFD, t) -> np.ndarray:
+def contour_normals(model: EFD, t) -> np.ndarray:
     """Inward unit normals of an EFD contour at parameters t.
 
     Parameters
@@ -247,7 +251,7 @@ def contour_normals(model: efd.EFD, t) -> np.ndarray:
         vanishes (a cusp of a truncated series), which the quality functions refuse.
     """
     t = np.asarray(t, dtype=float)
-    tangent = efd.evaluate(model, t.ravel(), derivative=1)
+    tangent = evaluate(model, t.ravel(), derivative=1)
     # fit() orients every model with positive signed area (counter-clockwise
     # with y up), so the interior lies to the left: rotate the tangent by +90 deg.
     inward = np.stack([-tangent[:, 1], tangent[:, 0]], axis=-1)
@@ -264,10 +268,14 @@ def _edge_wrenches(p, n, mu, centre, rho) -> np.ndarray:
     """(g, 2k, 3) edge wrenches of g grasps from points, unit normals (g, k, 2), centre (g, 2), rho (g,)."""
     t = np.stack([-n[..., 1], n[..., 0]], axis=-1)
     f = n[..., None, :] + mu * np.array([1.0, -1.0])[:, None] * t[..., None, :]  # (g, k, 2, 2)
-    arm = (p - centre[:, None, :])[..., None, :]
-    tau = arm[..., 0] * f[..., 1] - arm[..., 1] * f[..., 0]
-    w = np.concatenate([f, (tau / rho[:, None, None])[..., None]], axis=-1)
-    return w.reshape(len(p), -1, 3)
+    with np.errstate(over="ignore", invalid="ignore"):  # overflow is refused just below
+        arm = (p - centre[:, None, :])[..., None, :]
+        tau = arm[..., 0] * f[..., 1] - arm[..., 1] * f[..., 0]
+        w = np.concatenate([f, (tau / rho[:, None, None])[..., None]], axis=-1)
+    if not np.all(np.isfinite(w)):
+        raise QualityError("the contacts' torques overflow: the points lie too far from the centre "
+                           "(or rho is too small) for the wrench space")
+    return w.reshape(len(p), 2 * p.shape[1], 3)
 
 
 def _frame(p, ok, centre, rho) -> tuple[np.ndarray, np.ndarray]:
@@ -277,17 +285,17 @@ def _frame(p, ok, centre, rho) -> tuple[np.ndarray, np.ndarray]:
         count = np.maximum(ok.sum(axis=1, keepdims=True), 1)
         c = np.where(ok[..., None], p, 0.0).sum(axis=1) / count
     else:
-        c = np.asarray(centre, dtype=float)
+        c = check.float_array("centre", centre, error=QualityError)
         if c.shape not in {(2,), (g, 2)} or not np.all(np.isfinite(c)):
-            raise InputError(f"centre must be a finite (2,) point (or (p, 2) for many grasps), got {c.shape}")
+            raise QualityError(f"centre must be a finite (2,) point (or (p, 2) for many grasps), got {c.shape}")
         c = np.broadcast_to(c, (g, 2))
     if rho is None:
         reach = np.where(ok, np.linalg.norm(p - c[:, None, :], axis=-1), 0.0).max(axis=1, initial=0.0)
         # Contacts all at the centre exert no torque whatever rho is; 1 avoids 0 / 0.
         return c, np.where(reach > 0.0, reach, 1.0)
-    r = np.asarray(rho, dtype=float)
+    r = check.float_array("rho", rho, error=QualityError)
     if r.shape not in {(), (g,)} or not np.all(np.isfinite(r) & (r > 0)):
-        raise InputError(f"rho must be a positive finite length (or (p,) of them), got {rho!r}")
+        raise QualityError(f"rho must be a positive finite length (or (p,) of them), got {rho!r}")
     return c, np.broadcast_to(r, (g,))
 
 
@@ -325,7 +333,7 @@ def _ball_radius_batch(w: np.ndarray, ok: np.ndarray) -> np.ndarray:
     if m < 4:
         return out
     i, j, k = _triples(m)
-    chunk = max(1, _BATCH_ELEMENTS // (len(i) * m))
+    chunk = max(1, tol.WRENCH_BATCH_ELEMENTS // (len(i) * m))
     for s in range(0, g, chunk):
         ws, oks = w[s : s + chunk], ok[s : s + chunk]
         a = ws[:, i]
@@ -364,9 +372,9 @@ def _check_contacts(points, normals) -> tuple[np.ndarray, np.ndarray]:
     """Points and unit normals (n, 2) of one grasp."""
     p, n = _as_float(points, "points"), _as_float(normals, "normals")
     if p.ndim != 2 or p.shape[1] != 2:
-        raise InputError(f"points must be an (n, 2) array, got shape {p.shape}")
+        raise QualityError(f"points must be an (n, 2) array, got shape {p.shape}")
     if n.shape != p.shape:
-        raise InputError(f"normals must have the shape of points {p.shape}, got {n.shape}")
+        raise QualityError(f"normals must have the shape of points {p.shape}, got {n.shape}")
     p, n = _check_values(p, n)
     return p, n
 
@@ -375,12 +383,15 @@ def _check_contact_batch(points, normals, valid) -> tuple[np.ndarray, np.ndarray
     """Points, unit normals (g, k, 2) with invalid entries neutralised, and the valid mask (g, k)."""
     p, n = _as_float(points, "points"), _as_float(normals, "normals")
     if p.ndim != 3 or p.shape[2] != 2:
-        raise InputError(f"points must be a (p, n, 2) array, got shape {p.shape}")
+        raise QualityError(f"points must be a (p, n, 2) array, got shape {p.shape}")
     if n.shape != p.shape:
-        raise InputError(f"normals must have the shape of points {p.shape}, got {n.shape}")
-    ok = np.ones(p.shape[:2], bool) if valid is None else np.asarray(valid)
+        raise QualityError(f"normals must have the shape of points {p.shape}, got {n.shape}")
+    try:
+        ok = np.ones(p.shape[:2], bool) if valid is None else np.asarray(valid)
+    except (TypeError, ValueError):
+        raise QualityError(f"valid must be a {p.shape[:2]} bool array") from None
     if ok.shape != p.shape[:2] or ok.dtype != bool:
-        raise InputError(f"valid must be a {p.shape[:2]} bool array, got {ok.dtype} {ok.shape}")
+        raise QualityError(f"valid must be a {p.shape[:2]} bool array, got {ok.dtype} {ok.shape}")
     # Invalid contacts may hold NaN; give them harmless values, the mask drops them later.
     p, n = _check_values(np.where(ok[..., None], p, 0.0), np.where(ok[..., None], n, 1.0))
     return p, n, ok
@@ -391,41 +402,35 @@ def _check_values(p: np.ndarray, n: np.ndarray) -> tuple[np.ndarray, np.ndarray]
     for name, a in (("points", p), ("normals", n)):
         bad = ~np.all(np.isfinite(a), axis=-1)
         if np.any(bad):
-            raise InputError(f"{name}{_index(bad)} is not finite")
-    length = np.linalg.norm(n, axis=-1)
+            raise QualityError(f"{name}{_index(bad)} is not finite")
+    with np.errstate(over="ignore"):
+        length = np.linalg.norm(n, axis=-1)
+    huge = ~np.isfinite(length)
+    if np.any(huge):  # the squares overflowed: scale those normals down first
+        n = np.where(huge[..., None], n / np.abs(n).max(axis=-1, keepdims=True), n)
+        length = np.linalg.norm(n, axis=-1)
     if np.any(length <= tol.MIN_NORMAL):
-        raise InputError(f"normals{_index(length <= tol.MIN_NORMAL)} has zero length: no direction")
+        raise QualityError(f"normals{_index(length <= tol.MIN_NORMAL)} has zero length: no direction")
     return p, n / length[..., None]
 
 
 def _check_mu(mu) -> float:
-    try:
-        value = float(mu)
-    except (TypeError, ValueError):
-        raise InputError(f"mu must be a number, got {mu!r}") from None
-    if not np.isfinite(value) or value < 0:
-        raise InputError(f"mu must be a finite friction coefficient >= 0, got {mu!r}")
-    return value
+    return check.friction("mu", mu, tol.MAX_FRICTION, error=QualityError)
 
 
 def _check_metric(metric) -> str:
-    if metric not in METRICS:
-        raise InputError(f"metric must be one of {METRICS}, got {metric!r}")
-    return metric
+    return check.choice("metric", metric, METRICS, error=QualityError)
 
 
 def _check_linf_size(k: int) -> None:
-    if k > LINF_MAX_CONTACTS:
-        raise InputError(
-            f"metric 'Linf' takes at most {LINF_MAX_CONTACTS} contacts (3**n wrenches), got {k} points"
+    if k > tol.LINF_MAX_CONTACTS:
+        raise QualityError(
+            f"metric 'Linf' takes at most {tol.LINF_MAX_CONTACTS} contacts (3**n wrenches), got {k} points"
         )
 
 
 def _as_float(a, name: str) -> np.ndarray:
-    try:
-        return np.asarray(a, dtype=float)
-    except (TypeError, ValueError):
-        raise InputError(f"{name} must be an array of numbers") from None
+    return check.float_array(name, a, error=QualityError)
 
 
 def _index(mask: np.ndarray) -> str:

@@ -66,7 +66,7 @@ MIN_NORMAL = 1e-12
 HARMONICS_BOUNDS = (3, 12)
 
 #: Default of the "rms" rule: RMS distance to the upper-bound model, as a fraction of sqrt(area).
-#: Chosen by `python tools/harmonics_figure.py --sweep` (table in efd.choose_harmonics).
+#: Chosen by `python tools/harmonics_figure.py --sweep --sim` (benchmarks/harmonics_sweep.md).
 HARMONICS_RMS_TOLERANCE = 0.008
 
 #: Default of the "power" rule: share of the first harmonics' power the model may leave out.
@@ -74,3 +74,195 @@ HARMONICS_POWER_TOLERANCE = 2e-4
 
 #: Poses checked at once by the finger-thickness test; bounds its (poses, contour points, chords) arrays.
 POSE_BATCH = 256
+
+
+# --- perception ---
+from math import radians as _radians  # noqa: E402
+
+#: Working range of the thesis's depth sensor (section 4.1.2), meters.
+SENSOR_RANGE = (0.2, 1.5)
+
+#: A pixel belongs to the object when it stands this much (m) above the table.
+MIN_HEIGHT = 0.01
+
+#: RANSAC: a point within this distance (m) of a plane is one of its inliers.
+PLANE_THRESHOLD = 0.005
+
+#: RANSAC: candidate planes drawn.
+PLANE_ITERATIONS = 200
+
+#: RANSAC samples every PLANE_STRIDE-th pixel in both directions (all pixels vote for the final inliers).
+PLANE_STRIDE = 4
+
+#: RANSAC scores candidate planes on this many of the points, drawn at random (all of them vote for the refit).
+PLANE_SAMPLE = 2000
+
+#: A table holds at least this fraction of the valid depth pixels.
+MIN_PLANE_FRACTION = 0.2
+
+#: Planes tilted more than this from facing the camera are walls, not tables (rad).
+MAX_TABLE_TILT = _radians(60.0)
+
+#: Above this tilt (rad) the contour is planned in the table's plane rather than the image plane.
+TILT_PLANE_THRESHOLD = _radians(2.0)
+
+#: Above this tilt (rad) a warning says the top-down assumption is stretched.
+TILT_WARN = _radians(20.0)
+
+#: Smallest object, in pixels (about 2 x 2 cm at 0.7 m with a 525 px focal length).
+MIN_AREA_PX = 200
+
+#: A second candidate region at least this fraction of the largest's area draws a warning.
+SIMILAR_SIZE = 0.5
+
+#: Colour distance (CIELAB on OpenCV's 8-bit scale) from the table's colour that marks a possible object part.
+COLOUR_DISTANCE = 50.0
+
+#: Weight of lightness in that distance: shadows darken the table without changing its hue.
+LIGHTNESS_WEIGHT = 0.25
+
+#: A pixel darker than this fraction of the table's CIELAB lightness is object whatever its hue: darker
+#: than a soft shadow, which would have to block about 80 % of the light (the table's 8-bit colour x 0.48).
+SHADOW_LIGHTNESS = 0.5
+
+#: Colour evidence within this distance (px) of the depth mask is shadow or the object's side;
+#: only parts farther out are added to the depth mask.
+HALO_PX = 8
+
+#: Colour evidence is opened with a disc of this radius (px) to drop thin straps and specks.
+EVIDENCE_OPEN_PX = 2
+
+#: Colour evidence is first looked for within this distance (px) beyond the table ring around the depth
+#: mask; the whole image is searched only when the evidence reaches that window's edge.
+FLAT_WINDOW_PX = 96
+
+#: Largest colour-depth misregistration searched for, pixels in each direction.
+MAX_COLOUR_OFFSET_PX = 8
+
+#: The colour-depth registration compares edges over the object's bounding box grown by this, pixels.
+REGISTRATION_MARGIN_PX = 20
+
+#: Holes in the depth image up to this many pixels are filled.
+MAX_HOLE_PX = 400
+
+#: Tolerance (px) of the polygon simplification of the mask outline.
+CONTOUR_EPSILON_PX = 0.75
+
+#: At most this many points of a mask's outline (perception's pixel contour), so that O(n^2) checks
+#: downstream stay cheap. (``MAX_CONTOUR_POINTS`` below is the bound of any contour the planner takes.)
+MAX_OUTLINE_POINTS = 400
+
+#: Offset added to the minimum depth for the approach depth (section 3.1.1), m.
+APPROACH_OFFSET = 0.01
+
+#: The minimum depth for the approach is taken after a median filter of this size (px): the minimum of
+#: raw readings rides on their noise (about 5 mm nearer than the object's top with the simulated sensor's
+#: 2 mm at 0.7 m, 2 mm after the filter) and on single flying pixels; features 2 px wide survive it.
+APPROACH_MEDIAN_PX = 3
+
+#: A pixel ray meeting the planning plane at a cosine below this is refused as grazing.
+MIN_RAY_COSINE = 0.05
+
+#: Plausible bounds of the approach offset (|offset|, m) and of the pre-grasp standoff (m): a hand
+#: placed half a meter beyond or short of the object's top, or pulled back 2 m, is a typo (a unit
+#: slip, a sign), not a plan.
+MAX_APPROACH_OFFSET = 0.5
+MAX_STANDOFF = 2.0
+
+#: Largest deviation of R^T R from I, and of det R from 1, accepted in a rigid transform (T_base_camera).
+#: 1e-5 rather than 1e-6: a rotation printed with 6 decimals, as in the autolab
+#: ``.tf`` files, is off by up to about 1.5e-6 (the shared primesense.tf by 1.02e-6).
+ROTATION_TOLERANCE = 1e-5
+
+#: Largest deviation of a rigid transform's last row from 0 0 0 1.
+HOMOGENEOUS_ROW = 1e-9
+
+
+# --- sim ---
+
+#: A mesh whose largest extent exceeds this (m) is taken to be in millimetres.
+MESH_MAX_EXTENT = 1.0
+
+#: A mesh whose vertices all lie within this fraction of its size from its convex hull is convex enough
+#: to collide as its hull.
+MESH_CONVEX = 0.02
+
+#: A simulated fingertip this close to its full travel counts as closed, m: the soft joint limit lets it creep the rest.
+CLOSED_WITHIN = 5e-4
+
+#: A simulated fingertip that has travelled this far has started to move, m.
+FINGER_MOVED = 1e-3
+
+#: Closing times closer than this are a tie when calibrate chooses the reference finger (half a 2 ms step), s.
+CLOSING_TIE = 1e-3
+
+#: Contact distances per finger in calibrate's average over its travel (trapezoidal rule).
+TRAVEL_SAMPLES = 1001
+
+
+# --- contour ---
+
+#: A contour wider than this (m) is refused: no hand grasps it, even read as millimetres (a 10 m object),
+#: and far below it nothing derived from it (area, perimeter, the search grid) can overflow.
+MAX_CONTOUR_SIZE = 1e4
+
+#: A contour narrower than this (m) is refused: a tenth of a millimetre, far below a camera pixel at
+#: working distance (about 1.5 mm) and anything a hand grasps. At this width a polygon with less than
+#: MIN_AREA is a sliver a micrometre thick: "collinear" is then the right word for it.
+MIN_CONTOUR_SIZE = 1e-4
+
+#: A contour with more points than this is resampled uniformly by arc length to this many (a 1 m outline
+#: every 0.1 mm): the self-intersection test is O(n^2) and takes about 0.1 s at this size.
+MAX_CONTOUR_POINTS = 10_000
+
+#: Most harmonics an EFD may have (eq 3.3-3.4): far above any count worth fitting (the adaptive rule
+#: stops at HARMONICS_BOUNDS[1]), and the fit's (harmonics, points) arrays stay a few MB.
+MAX_HARMONICS = 100
+
+#: Two edges leaving one vertex at angles closer than this (rad) run along each other: where a contour
+#: passes twice through a point, such a pass touches the other rather than crossing it.
+SAME_DIRECTION = 1e-12
+
+
+# --- synthesis ---
+
+#: Largest friction coefficient accepted (quality metrics, Safeguards.friction): no real pair of
+#: materials reaches 10 (rubber on rubber is about 1-2), and far beyond it the friction cones' edges
+#: swamp their normals until Qhull fails on the wrench hull.
+MAX_FRICTION = 10.0
+
+#: Largest length of a hand (m): a finger's start, travel, virtual start, radius and an arc's radii.
+#: No hand the planner is meant for spans 2 m; beyond it a value is a unit slip (mm for m), and far
+#: beyond it the search's arithmetic over- or underflows.
+MAX_HAND_SIZE = 2.0
+
+#: Largest |phi_off| of an elliptic-arc finger (rad): any start angle is within 2 pi of one below
+#: this, and far beyond it cos and sin lose every digit of the angle.
+MAX_ARC_ANGLE = 100.0
+
+#: Largest length of the search (m): grid step, D_max, D_min and the safeguards' clearance. A
+#: hand is at most MAX_HAND_SIZE, so poses farther from the object than this reach nothing.
+MAX_SEARCH_LENGTH = 10.0
+
+#: Most poses of a search grid. The screen keeps about 0.4 kB per pose for a five-finger hand
+#: (contacts, parameters, curvature, distances, costs), so this bounds it to a few hundred MB;
+#: the `default` planner's grid has 172,980 poses and the dense bench case 345,960.
+MAX_GRID_POSES = 1_000_000
+
+#: Most rounds of the continuous refinement (refine_poses(rounds=...)); REFINE_ROUNDS is the default.
+REFINE_MAX_ROUNDS = 1000
+
+#: Largest magnitude of a hand's cost gains (alpha, beta, miss_penalty): the presets' largest is 1e4,
+#: and far beyond it a sum of costs overflows to inf (and inf - inf to NaN).
+MAX_GAIN = 1e9
+
+#: The L-inf wrench space (quality metric "Linf") has 3**n vertices before the hull; beyond this
+#: many contacts it is refused.
+LINF_MAX_CONTACTS = 8
+
+#: Elements of the (poses, planes, wrenches) array quality.epsilon_many evaluates at once.
+WRENCH_BATCH_ELEMENTS = 2_000_000
+
+#: Most fingers of a hand: every array of the search has one column per finger (about 65 bytes per
+#: pose and finger on the grid), and no hand the planner is meant for has more fingertips.
+MAX_FINGERS = 10

@@ -143,3 +143,77 @@ def options(name: str, value, function, *, error: type[InputError] = InputError)
     if unknown:
         raise error(f"{name}: unknown option {unknown[0]!r}; choose from {', '.join(allowed)}")
     return dict(value)
+
+
+# --- perception ---
+
+
+def depth_range(name: str, value, *, error: type[InputError] = InputError) -> tuple[float, float]:
+    """Two finite numbers (near, far), meters, with 0 <= near < far."""
+    try:
+        lo, hi = (finite(name, v, error=error) for v in value)
+    except (TypeError, ValueError):
+        raise error(f"{name} must be two numbers (near, far) in meters, got {value!r}") from None
+    if not 0 <= lo < hi:
+        raise error(f"{name} must satisfy 0 <= near < far, got ({lo}, {hi})")
+    return lo, hi
+
+
+def pixel_offset(name: str, value, *, error: type[InputError] = InputError) -> tuple[int, int]:
+    """Two integers (dx, dy), pixels."""
+    values = np.asarray(value, dtype=object) if isinstance(value, (tuple, list, np.ndarray)) else None
+    if values is None or values.shape != (2,) or not all(
+            isinstance(v, (int, np.integer)) and not isinstance(v, bool) for v in values):
+        raise error(f"{name} must be two integers (dx, dy), got {value!r}")
+    return int(values[0]), int(values[1])
+
+
+def pixel_contour(name: str, value, shape, *, error: type[InputError] = InputError) -> np.ndarray:
+    """An (n, 2) float array of at least 3 finite pixels (u, v) inside an image of ``shape`` (H, W, ...)."""
+    points = float_array(name, value, error=error)
+    if points.ndim != 2 or points.shape[1] != 2 or len(points) < 3:
+        raise error(f"{name} must be an (n, 2) array of at least 3 pixels (u, v), got shape {points.shape}")
+    if not np.all(np.isfinite(points)):
+        raise error(f"{name} point {int(np.flatnonzero(~np.all(np.isfinite(points), axis=1))[0])} is not finite")
+    outside = ((points[:, 0] < -0.5) | (points[:, 0] > shape[1] - 0.5)
+               | (points[:, 1] < -0.5) | (points[:, 1] > shape[0] - 0.5))
+    if outside.any():
+        i = int(np.flatnonzero(outside)[0])
+        raise error(f"{name} point {i} {tuple(points[i])} is outside the {shape[1]}x{shape[0]} image")
+    return points
+
+
+def rigid_transform(name: str, value, *, rotation_tolerance: float, row_tolerance: float,
+                    error: type[InputError] = InputError) -> np.ndarray:
+    """A finite (4, 4) rigid transform: last row 0 0 0 1, rotation orthonormal with det +1 (within the tolerances).
+
+    Returned as given (as a float array); nothing is re-orthonormalised here.
+    """
+    matrix = finite_array(name, value, (4, 4), error=error)
+    if np.abs(matrix[3] - [0.0, 0.0, 0.0, 1.0]).max() > row_tolerance:
+        raise error(f"{name}: the last row of a rigid transform must be 0 0 0 1, got {matrix[3].tolist()}")
+    rotation = matrix[:3, :3]
+    deviation = float(np.abs(rotation.T @ rotation - np.eye(3)).max())
+    det = float(np.linalg.det(rotation))
+    if not (deviation <= rotation_tolerance and abs(det - 1) <= rotation_tolerance):
+        raise error(f"{name}: the rotation is not orthonormal with det +1 (|R^T R - I| = {deviation:.2e}, "
+                    f"det = {det:.6f}; tolerance {rotation_tolerance:g})")
+    return matrix
+
+
+# --- synthesis ---
+
+
+def bounded(name: str, value, limit: float, unit: str = "", *, strict: bool = False,
+            error: type[InputError] = InputError) -> float:
+    """A finite number >= 0 (> 0 if ``strict``) and at most ``limit``."""
+    value = (positive if strict else non_negative)(name, value, error=error)
+    return at_most(name, value, limit, unit, error=error)
+
+
+def friction(name: str, value, limit: float, *, error: type[InputError] = InputError) -> float:
+    """A Coulomb friction coefficient: a finite number in [0, ``limit``] (``tolerances.MAX_FRICTION``)."""
+    value = non_negative(name, value, error=error)
+    if value > limit:
+        raise error(f"{name} must be a friction coefficient of at most {limit:g}, got {value:g}")
+    return value

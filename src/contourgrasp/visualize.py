@@ -15,7 +15,7 @@ from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 from mpl_toolkits.axes_grid1.anchored_artists import AnchoredSizeBar
 
-from . import efd as efd_model
+from . import contour as efd_model
 from .hand import to_image
 from .synthesis import GraspPlan
 
@@ -70,8 +70,23 @@ def _finish_axes(ax, scale: float = 0.05) -> None:
         ax.invert_yaxis()
     ax.set_xlabel("x [m] (image right)")
     ax.set_ylabel("y [m] (image down)")
-    ax.add_artist(AnchoredSizeBar(ax.transData, scale, f"{scale * 100:.0f} cm", "lower right", frameon=False, size_vertical=scale / 40))
+    ax.add_artist(AnchoredSizeBar(ax.transData, scale, _length_label(scale), "lower right", frameon=False,
+                                  size_vertical=scale / 40))
     ax.grid(alpha=0.3)
+
+
+def _scale_bar(extent: float) -> float:
+    """The longest of 1, 2, 5 x 10^k m within a quarter of ``extent``: 2 cm for the thesis's objects."""
+    decade = 10.0 ** math.floor(math.log10(extent / 4))
+    return max(step * decade for step in (1, 2, 5) if step * decade <= extent / 4)
+
+
+def _length_label(length: float) -> str:
+    """``length`` m in the unit that reads best: "2 cm", "50 µm", "20 m"."""
+    for unit, size in (("m", 1.0), ("cm", 1e-2), ("mm", 1e-3), ("µm", 1e-6)):
+        if length >= size:
+            return f"{round(length / size, 9):g} {unit}"
+    return f"{length:.3g} m"
 
 
 def plan_figure(plan: GraspPlan) -> Figure:
@@ -93,8 +108,24 @@ def plan_figure(plan: GraspPlan) -> Figure:
 
 
 def harmonics_figure(contour_xy, harmonics: Sequence[int] = (1, 2, 4, 8), *, curvature: str = "paper") -> Figure:
-    """The thesis's Figure 4.5: one contour approximated with several harmonic counts."""
+    """The thesis's Figure 4.5: one contour approximated with several harmonic counts.
+
+    Parameters
+    ----------
+    contour_xy : (n, 2) float
+        Polygon in meters, checked by :func:`contourgrasp.contour.clean_polygon`.
+    harmonics : sequence of int
+        One panel per count.
+    curvature : {"paper", "geometric"}
+        Flavour deciding the concave stretches (blue).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The scale bar's length follows the contour's size (2 cm for the thesis's objects).
+    """
     contour = efd_model.clean_polygon(contour_xy, check_units=False)
+    scale = _scale_bar(float(np.max(np.ptp(contour, axis=0))))
     fig = Figure(figsize=(3.2 * len(harmonics), 3.6), layout="constrained")
     axes = fig.subplots(1, len(harmonics), sharex=True, sharey=True, squeeze=False)[0]
     for ax, k in zip(axes, harmonics):
@@ -102,7 +133,7 @@ def harmonics_figure(contour_xy, harmonics: Sequence[int] = (1, 2, 4, 8), *, cur
         ax.plot(*np.vstack([contour, contour[:1]]).T, color="0.7", lw=1)
         draw_efd(ax, model, curvature=curvature)
         ax.set_title(f"{k} harmonic{'s' if k > 1 else ''}")
-        _finish_axes(ax, scale=0.02)
+        _finish_axes(ax, scale=scale)
     fig.suptitle(f"EFD approximation; concave stretches in blue ({curvature} curvature)", fontsize=10)
     return fig
 

@@ -1,7 +1,10 @@
 import math
+import re
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import contourgrasp as cg
 from contourgrasp import HandFileError
@@ -99,3 +102,67 @@ def test_hand_to_toml_escapes_names():
     hand = Hand(name="x\ny", fingers=(finger,), min_touching=1, description="tab\there")
     again = parse_hand(hand_to_toml(hand))
     assert (again.name, again.fingers[0].name, again.description) == (hand.name, finger.name, hand.description)
+
+
+ONE_FINGER = """name = "h"
+min_touching = 1
+
+[[fingers]]
+name = "left"
+start = [-0.08, 0.0]
+closing_direction = [1.0, 0.0]
+travel = 0.1
+"""
+
+
+@pytest.mark.parametrize("line, field", [("virtual_start = 1e300", "fingers[0] (left).virtual_start"),
+                                         ("radius = 1e300", "fingers[0] (left).radius"),
+                                         ("alpha = -1e300", "fingers[0] (left).alpha"),
+                                         ("beta = 1e300", "fingers[0] (left).beta")])
+def test_absurd_magnitudes_are_refused_naming_the_field(tmp_path, line, field):
+    """virtual_start = 1e300 was once accepted and wrote Infinity into the plan JSON."""
+    path = tmp_path / "hand.toml"
+    path.write_text(ONE_FINGER + line + "\n")
+    with pytest.raises(HandFileError, match=f"hand.toml: {re.escape(field)}: .*(less|greater) than or equal"):
+        load_hand(path)
+
+
+@pytest.mark.parametrize("old, new, field", [("start = [-0.08, 0.0]", "start = [1e300, 0.0]", "start"),
+                                             ("travel = 0.1", "travel = 1e300", "travel"),
+                                             ('closing_direction = [1.0, 0.0]',
+                                              "arc = { a_cos = 0.05, a_sin = 0.04, phi_off = 1e300 }", "phi_off"),
+                                             ('closing_direction = [1.0, 0.0]',
+                                              "arc = { a_cos = 1e300, a_sin = 0.04, phi_off = 0.0 }", "a_cos")])
+def test_absurd_lengths_and_angles_are_refused_naming_the_field(old, new, field):
+    """A start of 1e300 or an arc phi_off of 1e300 once divided by zero in the search's kernels."""
+    with pytest.raises(HandFileError, match=f"fingers\\[0\\] \\(left\\).*{field}"):
+        parse_hand(ONE_FINGER.replace(old, new), source="hand.toml")
+
+
+@pytest.mark.parametrize("content", [bytes(range(256)), "name = 'h'".encode("utf-16"), b"\xff\xfe\x00"])
+def test_a_binary_or_utf16_file_is_one_hand_file_error_naming_it(tmp_path, content):
+    path = tmp_path / "hand.toml"
+    path.write_bytes(content)
+    with pytest.raises(HandFileError, match=f"{re.escape(str(path))}: cannot read hand file \\(not UTF-8"):
+        load_hand(path)
+
+
+def test_deeply_nested_toml_is_one_hand_file_error():
+    with pytest.raises(HandFileError, match="hand.toml: not valid TOML"):
+        parse_hand("x = " + "[" * 100_000 + "]" * 100_000, source="hand.toml")
+
+
+@settings(max_examples=100, deadline=None)
+@given(content=st.one_of(st.binary(max_size=300), st.text(max_size=300).map(str.encode),
+                         st.sampled_from([ONE_FINGER.encode(), ONE_FINGER.encode("utf-16")]),
+                         st.builds(lambda cut, junk: ONE_FINGER.encode()[:cut] + junk, st.integers(0, 150),
+                                   st.binary(max_size=20))))
+def test_fuzz_load_hand_on_random_bytes_gives_a_hand_or_a_hand_file_error(tmp_path_factory, content):
+    path = tmp_path_factory.mktemp("fuzz") / "hand.toml"
+    path.write_bytes(content)
+    try:
+        hand = load_hand(path)
+    except HandFileError as err:
+        assert str(err).startswith(str(path)) and "\n" not in str(err)
+        return
+    assert np.all(np.isfinite(hand.starts))

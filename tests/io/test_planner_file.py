@@ -1,11 +1,14 @@
 import json
 import math
+import re
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import contourgrasp as cg
 from contourgrasp.io.planner_file import PlannerFileError, load_planner, parse_planner, planner_names
-from contourgrasp.synthesis import synthesize
+from contourgrasp.synthesis import search
 
 
 def test_presets_load_and_paper_is_the_thesis():
@@ -19,7 +22,7 @@ def test_presets_load_and_paper_is_the_thesis():
 @pytest.mark.parametrize("name", ["paper", "default"])
 def test_preset_options_are_accepted_by_synthesis(name):
     options = load_planner(name).synthesis_options | {"xy_step": 0.03, "yaw_step": math.radians(15)}
-    plan = synthesize(cg.example_contour("case"), cg.load_hand("three-finger"), **options)
+    plan = search(cg.example_contour("case"), cg.load_hand("three-finger"), **options)
     assert plan.grid.xy_step == 0.03
 
 
@@ -79,7 +82,55 @@ def test_cli_harmonics_takes_a_count_or_adaptive(tmp_path, capsys):
     assert main([*args, "--harmonics", "adaptive"]) == 0
     assert json.loads(out.read_text())["efd"]["harmonics"] == 8  # the thesis's count for stone 2
     out.unlink()
-    with pytest.raises(SystemExit) as exit_:
-        main([*args, "--harmonics", "many"])
-    assert exit_.value.code == 2 and "positive integer or 'adaptive', got many" in capsys.readouterr().err
+    assert main([*args, "--harmonics", "many"]) == 2
+    assert "positive integer or 'adaptive', got 'many'" in capsys.readouterr().err
     assert not out.exists()
+
+
+@pytest.mark.parametrize("text, message", [
+    ('xy_step = 1e-4\nd_max = 1.0', "the search grid would have 7.2e+10 poses (x 20001 × y 20001 × yaw 180); "
+                                    "at most 1,000,000"),
+    ("yaw_step = 1e-9", "the search grid would have"),
+    ("d_max = 1e6", "d_max"),
+    ("harmonics = 1000000", "harmonics: Input should be less than or equal to 100"),
+    ("friction = 1e300", "friction"),
+    ("clearance = 1e300", "clearance"),
+])
+def test_unbounded_work_in_a_planner_file_is_refused_naming_the_limit(text, message):
+    with pytest.raises(PlannerFileError, match=re.escape(f"p.toml: {message}")):
+        parse_planner(f'name = "x"\n{text}\n', source="p.toml")
+
+
+def test_a_planner_file_error_is_a_planner_error():
+    assert issubclass(PlannerFileError, cg.PlannerError)
+
+
+@pytest.mark.parametrize("content", [bytes(range(256)), 'name = "x"'.encode("utf-16")])
+def test_a_binary_or_utf16_planner_is_one_planner_file_error_naming_it(tmp_path, content):
+    path = tmp_path / "p.toml"
+    path.write_bytes(content)
+    with pytest.raises(PlannerFileError, match=f"{re.escape(str(path))}: cannot read planner file \\(not UTF-8"):
+        load_planner(path)
+
+
+def test_deeply_nested_planner_toml_is_one_planner_file_error():
+    with pytest.raises(PlannerFileError, match="p.toml: not valid TOML"):
+        parse_planner("x = " + "{a = " * 50_000 + "1" + "}" * 50_000, source="p.toml")
+
+
+@settings(max_examples=100, deadline=None)
+@given(content=st.one_of(st.binary(max_size=300), st.text(max_size=300).map(str.encode),
+                         st.builds(lambda key, value: f'name = "x"\n{key} = {value}\n'.encode(),
+                                   st.sampled_from(["xy_step", "yaw_step", "d_max", "d_min", "harmonics", "friction",
+                                                    "clearance", "quality_gain", "refine"]),
+                                   st.sampled_from(["1e-300", "1e300", "-1", "0", "nan", "inf", "1000000", '"x"',
+                                                    "[0.1, 1e300]", "true", "0.05"]))))
+def test_fuzz_load_planner_on_random_bytes_gives_a_planner_or_a_planner_file_error(tmp_path_factory, content):
+    path = tmp_path_factory.mktemp("fuzz") / "p.toml"
+    path.write_bytes(content)
+    try:
+        planner = load_planner(path)
+    except PlannerFileError as err:
+        assert str(err).startswith(str(path)) and "\n" not in str(err)
+        return
+    assert planner.name == "x"

@@ -27,13 +27,20 @@ def read_spec(spec: str, folder: str, *, kind: str, error: type[Exception]) -> t
         raise error(f"unknown {kind} {spec!r}: not a preset ({', '.join(names)}) nor a file")
     try:
         return path.read_text(encoding="utf-8"), str(path)
-    except (OSError, UnicodeDecodeError) as err:
+    except UnicodeDecodeError as err:
+        raise error(f"{path}: cannot read {kind} file (not UTF-8 text: byte {err.start} is 0x{err.object[err.start]:02x})") from None
+    except OSError as err:
         raise error(f"{path}: cannot read {kind} file ({err.strerror or err})") from None
 
 
 def parse_toml(text: str, source: str, *, error: type[Exception]) -> dict:
-    """The TOML document ``text``; ``error`` names ``source`` when it is not valid TOML."""
+    """The TOML document ``text``; ``error`` names ``source`` when it is not valid TOML.
+
+    A document nested too deeply for the parser (it recurses) is refused as invalid.
+    """
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
         raise error(f"{source}: not valid TOML ({err})") from None
+    except RecursionError:
+        raise error(f"{source}: not valid TOML (arrays or tables nested too deeply)") from None

@@ -32,15 +32,19 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import warnings
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
 import cv2
 import numpy as np
 
+from .. import validation
 from ..errors import InputError, UnitWarning
 from ..perception import Intrinsics
+from ..tolerances import HOMOGENEOUS_ROW, ROTATION_TOLERANCE
 
 #: Default raw-unit size of integer depth images, m (millimetres).
 DEPTH_SCALE = 0.001
@@ -50,11 +54,6 @@ MAX_PLAUSIBLE_DEPTH = 20.0
 
 #: A median depth below this (m) is closer than any depth camera measures.
 MIN_PLAUSIBLE_DEPTH = 0.02
-
-#: Largest deviation of R^T R from I, and of det R from 1, accepted in an extrinsics file.
-#: 1e-5 rather than 1e-6: a rotation printed with 6 decimals, as in the autolab
-#: ``.tf`` files, is off by up to about 1.5e-6 (the shared primesense.tf by 1.02e-6).
-ROTATION_TOLERANCE = 1e-5
 
 __all__ = [
     "DEPTH_SCALE", "Intrinsics", "RGBDFrame", "read_depth", "read_extrinsics", "read_intrinsics", "read_mask",
@@ -73,11 +72,14 @@ class RGBDFrame:
     depth : (H, W) float or None
         Depth in meters, 0 or NaN where missing.
     intrinsics : Intrinsics or None
+    mask : (H, W) bool or None
+        The user's object mask (:func:`read_mask`), when one was given.
     """
 
     rgb: np.ndarray | None
     depth: np.ndarray | None
     intrinsics: Intrinsics | None
+    mask: np.ndarray | None = None
 
 
 def read_rgb(path) -> np.ndarray:
@@ -248,26 +250,19 @@ def _homogeneous(rotation, translation) -> np.ndarray:
 
 
 def _check_rigid(path, matrix) -> np.ndarray:
-    if np.abs(matrix[3] - [0.0, 0.0, 0.0, 1.0]).max() > 1e-9:
-        raise InputError(f"{path}: the last row of a rigid transform must be 0 0 0 1, got {matrix[3].tolist()}")
-    rotation = matrix[:3, :3]
-    error = float(np.abs(rotation.T @ rotation - np.eye(3)).max())
-    det = float(np.linalg.det(rotation))
-    if error > ROTATION_TOLERANCE or abs(det - 1) > ROTATION_TOLERANCE:
-        raise InputError(
-            f"{path}: the rotation is not orthonormal with det +1 (|R^T R - I| = {error:.2e}, det = {det:.6f}; "
-            f"tolerance {ROTATION_TOLERANCE:g})"
-        )
-    u, _, vt = np.linalg.svd(rotation)
+    validation.rigid_transform(str(path), matrix, rotation_tolerance=ROTATION_TOLERANCE,
+                               row_tolerance=HOMOGENEOUS_ROW)
+    u, _, vt = np.linalg.svd(matrix[:3, :3])
     out = matrix.copy()
     out[:3, :3] = u @ vt
     return out
 
 
-def read_rgbd(rgb_path=None, depth_path=None, intrinsics_path=None, *, depth_scale: float = DEPTH_SCALE) -> RGBDFrame:
+def read_rgbd(rgb_path=None, depth_path=None, intrinsics_path=None, *, mask_path=None,
+              depth_scale: float = DEPTH_SCALE) -> RGBDFrame:
     """Read the files of one frame and check their sizes agree.
 
-    Any of the three may be None; depth needs intrinsics.
+    Any of them may be None; depth needs intrinsics.
 
     Raises
     ------
@@ -280,7 +275,8 @@ def read_rgbd(rgb_path=None, depth_path=None, intrinsics_path=None, *, depth_sca
     rgb = None if rgb_path is None else read_rgb(rgb_path)
     depth = None if depth_path is None else read_depth(depth_path, depth_scale=depth_scale)
     intrinsics = None if intrinsics_path is None else read_intrinsics(intrinsics_path)
-    sized = [(p, a.shape) for p, a in ((rgb_path, rgb), (depth_path, depth)) if a is not None]
+    mask = None if mask_path is None else read_mask(mask_path)
+    sized = [(p, a.shape) for p, a in ((rgb_path, rgb), (depth_path, depth), (mask_path, mask)) if a is not None]
     if intrinsics is not None:
         sized.append((intrinsics_path, intrinsics.shape))
     for (path_a, shape_a), (path_b, shape_b) in zip(sized, sized[1:]):
@@ -288,7 +284,7 @@ def read_rgbd(rgb_path=None, depth_path=None, intrinsics_path=None, *, depth_sca
             raise InputError(
                 f"{path_a} is {shape_a[1]}x{shape_a[0]} but {path_b} is {shape_b[1]}x{shape_b[0]} (width x height)"
             )
-    return RGBDFrame(rgb=rgb, depth=depth, intrinsics=intrinsics)
+    return RGBDFrame(rgb=rgb, depth=depth, intrinsics=intrinsics, mask=mask)
 
 
 # ---------------------------------------------------------------------------
@@ -304,10 +300,31 @@ def _require_file(path: Path) -> None:
 def _read_image(path, flags) -> np.ndarray:
     path = Path(path)
     _require_file(path)
-    image = cv2.imread(str(path), flags)
+    try:
+        data = np.frombuffer(path.read_bytes(), dtype=np.uint8)
+    except OSError as err:
+        raise InputError(f"{path}: cannot read file ({err.strerror or err})") from None
+    with _quiet_stderr():
+        try:
+            image = cv2.imdecode(data, flags) if data.size else None
+        except cv2.error:
+            image = None
     if image is None:
         raise InputError(f"{path}: not a readable image (PNG, JPG, TIFF, ...)")
     return image
+
+
+@contextmanager
+def _quiet_stderr():
+    """File descriptor 2 sent to /dev/null: OpenCV's decoders (libpng) print their errors from C."""
+    saved = os.dup(2)
+    try:
+        with open(os.devnull, "wb") as null:
+            os.dup2(null.fileno(), 2)
+        yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
 
 
 def _load_npy(path: Path) -> np.ndarray:
@@ -316,8 +333,8 @@ def _load_npy(path: Path) -> np.ndarray:
         data = np.load(path, allow_pickle=False)
     except (OSError, ValueError, EOFError) as err:
         raise InputError(f"{path}: not a readable .npy array ({err})") from None
-    if not isinstance(data, np.ndarray) or not (data.dtype == bool or np.issubdtype(data.dtype, np.number)):
-        raise InputError(f"{path}: expected a numeric array")
+    if not isinstance(data, np.ndarray) or data.dtype.kind not in "biuf":
+        raise InputError(f"{path}: expected an array of real numbers, got dtype {getattr(data, 'dtype', None)}")
     return data
 
 
@@ -338,10 +355,14 @@ def _read_mapping(path: Path):
             return yaml.safe_load(text)
         except yaml.YAMLError as err:
             raise InputError(f"{path}: not valid YAML ({' '.join(str(err).split())})") from None
+        except RecursionError:
+            raise InputError(f"{path}: nested too deeply to be camera data") from None
     try:
         return json.loads(text)
     except json.JSONDecodeError as err:
         raise InputError(f"{path}: not valid JSON ({err})") from None
+    except RecursionError:
+        raise InputError(f"{path}: nested too deeply to be camera data") from None
 
 
 def _field(path, data: dict, key: str, name: str | None = None):

@@ -22,8 +22,11 @@ Schema (all lengths in meters, angles in radians)::
     radius = 0.011                   # optional, >= 0, default 0: half the finger's
                                      # width (finger-thickness check of the planner)
 
-Unknown keys, wrong types and impossible values are refused with
-:class:`~contourgrasp.errors.HandFileError` naming the file and the field.
+Lengths are at most ``tolerances.MAX_HAND_SIZE`` (2 m) in magnitude, ``|phi_off|`` at most
+``tolerances.MAX_ARC_ANGLE``, gains (alpha, beta, miss_penalty) at most ``tolerances.MAX_GAIN``
+and a hand has at most ``tolerances.MAX_FINGERS`` fingers. Unknown keys, wrong types and
+impossible values are refused with :class:`~contourgrasp.errors.HandFileError` naming the file
+and the field; so is a file that is not UTF-8 text or TOML.
 """
 
 from __future__ import annotations
@@ -33,7 +36,8 @@ from typing import Annotated
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from ..errors import HandFileError
+from .. import tolerances as tol
+from ..errors import HandError, HandFileError
 from ..hand import Arc, Finger, Hand, Ray
 from . import _toml_files
 
@@ -42,8 +46,13 @@ _PRESET_DIR = "data/hands"
 #: Default miss_penalty per unit of the largest curvature gain alpha.
 MISS_PENALTY_PER_ALPHA = 10.0
 
-PositiveFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 FiniteFloat = Annotated[float, Field(allow_inf_nan=False)]
+Length = Annotated[float, Field(gt=0, le=tol.MAX_HAND_SIZE, allow_inf_nan=False)]
+Offset = Annotated[float, Field(ge=-tol.MAX_HAND_SIZE, le=tol.MAX_HAND_SIZE, allow_inf_nan=False)]
+Radius = Annotated[float, Field(ge=0, le=tol.MAX_HAND_SIZE, allow_inf_nan=False)]
+Gain = Annotated[float, Field(ge=0, le=tol.MAX_GAIN, allow_inf_nan=False)]
+Angle = Annotated[float, Field(ge=-tol.MAX_ARC_ANGLE, le=tol.MAX_ARC_ANGLE, allow_inf_nan=False)]
+Point2 = Annotated[list[Offset], Field(min_length=2, max_length=2)]
 Vector2 = Annotated[list[FiniteFloat], Field(min_length=2, max_length=2)]
 
 
@@ -52,22 +61,22 @@ class _Strict(BaseModel):
 
 
 class _ArcSchema(_Strict):
-    a_cos: PositiveFloat
-    a_sin: PositiveFloat
-    phi_off: FiniteFloat
+    a_cos: Length
+    a_sin: Length
+    phi_off: Angle
 
 
 class _FingerSchema(_Strict):
     name: str = Field(min_length=1)
-    start: Vector2
+    start: Point2
     closing_direction: Vector2 | None = None
     arc: _ArcSchema | None = None
-    travel: PositiveFloat
-    virtual_start: FiniteFloat = 0.0
-    alpha: FiniteFloat = 1.0
-    beta: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.0
+    travel: Length
+    virtual_start: Offset = 0.0
+    alpha: Annotated[float, Field(ge=-tol.MAX_GAIN, le=tol.MAX_GAIN, allow_inf_nan=False)] = 1.0
+    beta: Gain = 0.0
     required: bool = False
-    radius: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.0
+    radius: Radius = 0.0
 
     @model_validator(mode="after")
     def _one_trajectory(self):
@@ -82,8 +91,8 @@ class _HandSchema(_Strict):
     name: str = Field(min_length=1)
     description: str = ""
     min_touching: int = Field(ge=1)
-    miss_penalty: Annotated[float, Field(ge=0, allow_inf_nan=False)] | None = None
-    fingers: list[_FingerSchema] = Field(min_length=1)
+    miss_penalty: Gain | None = None
+    fingers: list[_FingerSchema] = Field(min_length=1, max_length=tol.MAX_FINGERS)
 
     @model_validator(mode="after")
     def _consistent(self):
@@ -122,16 +131,15 @@ def parse_hand(text: str, *, source: str = "<string>") -> Hand:
     except ValidationError as err:
         raise HandFileError(f"{source}: {_describe(err, raw)}") from None
     try:
-        fingers = tuple(_finger(f) for f in schema.fingers)
-    except ValueError as err:
+        return Hand(
+            name=schema.name,
+            fingers=tuple(_finger(f) for f in schema.fingers),
+            min_touching=schema.min_touching,
+            miss_penalty=_miss_penalty(schema),
+            description=schema.description,
+        )
+    except HandError as err:
         raise HandFileError(f"{source}: {err}") from None
-    return Hand(
-        name=schema.name,
-        fingers=fingers,
-        min_touching=schema.min_touching,
-        miss_penalty=_miss_penalty(schema),
-        description=schema.description,
-    )
 
 
 def _miss_penalty(schema: _HandSchema) -> float:

@@ -4,14 +4,17 @@ from __future__ import annotations
 
 import contextlib
 import json
+import math
 import os
+import shutil
+import stat
 import tempfile
 from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import OutputError
 from ..synthesis import GraspPlan
 
 
@@ -108,34 +111,131 @@ def image_plan_to_dict(result) -> dict:
 
 
 @contextlib.contextmanager
-def atomic_outputs(*paths):
-    """Yield temporary paths beside ``paths``; move them into place only if the block succeeds.
+def atomic_outputs(*paths, inputs=()):
+    """Yield temporary paths beside ``paths``; move them into place only if the block succeeds, all or none.
 
-    ``None`` entries are passed through as ``None``. On any exception every
-    temporary file is removed and no output file is created or changed.
+    Every target is checked before anything is written: not a directory, its
+    folder exists and is writable, no target given twice, none equal to one of
+    ``inputs`` (the files the outputs are computed from). Then the block writes
+    the temporary files, and they are renamed over their targets; if a rename
+    fails, the targets already replaced get their old content back. An existing
+    output keeps its permissions; a new one gets the usual ``0666 & ~umask``.
+
+    Parameters
+    ----------
+    *paths : str, Path or None
+        Output files; ``None`` entries are passed through as ``None``.
+    inputs : iterable of str or Path
+        Files that must not be overwritten (``None`` entries and names that are
+        not files, such as ``example:can``, are ignored).
+
+    Raises
+    ------
+    OutputError
+        A target that cannot be written; or, raised from the block, an
+        ``OSError`` on one of the temporary files, re-raised naming its target.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> with atomic_outputs(folder / "a.txt", None) as (a, none):
+    ...     _ = a.write_text("done")
+    >>> (folder / "a.txt").read_text(), none
+    ('done', None)
     """
+    targets = [None if p is None else Path(p) for p in paths]
+    _check_targets(targets, inputs)
     temps = []
     try:
-        for path in paths:
-            if path is None:
-                temps.append(None)
-                continue
-            path = Path(path)
-            if not path.parent.is_dir():
-                raise InputError(f"{path}: cannot write, directory {path.parent} does not exist")
-            fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent or ".")
-            os.close(fd)
-            temps.append(Path(tmp))
-        yield temps
-        mode = 0o666 & ~_umask()  # mkstemp makes 0600 files; outputs get the usual permissions
-        for tmp, path in zip(temps, paths):
-            if tmp is not None:
-                os.chmod(tmp, mode)
-                os.replace(tmp, path)
+        temps = [None if path is None else _temporary(path) for path in targets]
+        try:
+            yield temps
+        except OSError as err:
+            named = {str(t): p for t, p in zip(temps, targets) if t is not None}
+            if str(err.filename) in named:
+                raise OutputError(f"cannot write {named[str(err.filename)]}: {err.strerror}") from None
+            raise
+        _replace_all([(t, p) for t, p in zip(temps, targets) if t is not None])
     finally:
         for tmp in temps:
             if tmp is not None and tmp.exists():
                 tmp.unlink()
+
+
+def _check_targets(targets, inputs) -> None:
+    """Refuse, before anything is written, every output that could not be written or would clobber an input."""
+    seen = {}
+    protected = {_key(Path(p)): Path(p) for p in inputs if p is not None and Path(p).is_file()}
+    for path in (p for p in targets if p is not None):
+        key = _key(path)
+        if key in seen:
+            also = "" if str(seen[key]) == str(path) else f" (also as {seen[key]})"
+            raise OutputError(f"{path}: given twice as an output{also}")
+        if key in protected:
+            raise OutputError(f"{path}: the output would overwrite the input file {protected[key]}")
+        seen[key] = path
+        if path.is_dir():
+            raise OutputError(f"{path}: cannot write, it is a directory")
+        if not path.parent.is_dir():
+            raise OutputError(f"{path}: cannot write, directory {path.parent} does not exist")
+        if not os.access(path.parent, os.W_OK | os.X_OK):
+            raise OutputError(f"{path}: cannot write, directory {path.parent} is not writable")
+
+
+def _key(path: Path) -> str:
+    """One name per file: the resolved path (symbolic links followed, ``..`` removed)."""
+    return os.path.normcase(str(path.resolve()))
+
+
+def _temporary(path: Path) -> Path:
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
+    except OSError as err:
+        raise OutputError(f"cannot write {path}: {err.strerror}") from None
+    os.close(fd)
+    return Path(tmp)
+
+
+def _replace_all(pairs) -> None:
+    """Rename every (temporary, target) pair; on a failure put back the targets already replaced."""
+    backups, done = {}, []
+    try:
+        for tmp, path in pairs:
+            os.chmod(tmp, _mode(path))
+            if path.exists():
+                backups[path] = _backup(path, tmp)
+            os.replace(tmp, path)
+            done.append(path)
+    except OSError as err:
+        for path in reversed(done):
+            if path in backups:
+                os.replace(backups.pop(path), path)
+            else:
+                path.unlink(missing_ok=True)
+        failed = pairs[len(done)][1]
+        raise OutputError(f"cannot write {failed}: {err.strerror}; no output was changed") from None
+    finally:
+        for backup in backups.values():
+            backup.unlink(missing_ok=True)
+
+
+def _mode(path: Path) -> int:
+    """The permissions an output gets: the existing file's, else 0666 less the umask (mkstemp makes 0600)."""
+    try:
+        return stat.S_IMODE(path.stat().st_mode)
+    except FileNotFoundError:
+        return 0o666 & ~_umask()
+
+
+def _backup(path: Path, tmp: Path) -> Path:
+    """A hard link to (or, where links are not supported, a copy of) the file about to be replaced."""
+    backup = tmp.with_name(tmp.name + ".old")
+    try:
+        os.link(path, backup)
+    except OSError:
+        shutil.copy2(path, backup)
+    return backup
 
 
 def _umask() -> int:
@@ -144,6 +244,27 @@ def _umask() -> int:
     return mask
 
 
-def write_json(data: dict, path) -> None:
-    """Write ``data`` as indented JSON to ``path`` (a temporary path from :func:`atomic_outputs`)."""
-    Path(path).write_text(json.dumps(data, indent=2) + "\n", encoding="utf-8")
+def write_json(data, path) -> None:
+    """Write ``data`` as indented JSON to ``path`` (a temporary path from :func:`atomic_outputs`).
+
+    Raises
+    ------
+    OutputError
+        ``data`` holds a NaN or an infinity, which JSON cannot represent.
+    """
+    field = _non_finite(data)
+    if field is not None:
+        raise OutputError(f"the JSON output cannot hold {field[0]} = {field[1]} (JSON has no NaN or infinity)")
+    Path(path).write_text(json.dumps(data, indent=2, allow_nan=False) + "\n", encoding="utf-8")
+
+
+def _non_finite(data, where: str = "") -> tuple[str, float] | None:
+    """(field, value) of the first NaN or infinite number in nested dicts and lists, or None."""
+    if isinstance(data, float):
+        return None if math.isfinite(data) else (where or "value", data)
+    items = data.items() if isinstance(data, dict) else enumerate(data) if isinstance(data, (list, tuple)) else ()
+    for key, value in items:
+        found = _non_finite(value, f"{where}.{key}" if isinstance(key, str) else f"{where}[{key}]")
+        if found is not None:
+            return found[0].lstrip("."), found[1]
+    return None

@@ -1,4 +1,4 @@
-"""Planner files (TOML): named settings of :func:`contourgrasp.pipeline.plan_grasp`, and the presets.
+"""Planner files (TOML): named settings of :func:`contourgrasp.pipeline.plan_frame`, and the presets.
 
 A planner is the part of a plan that is not the hand: how the contour is
 modelled, how finely poses are searched, which safeguards apply. ``paper``
@@ -26,7 +26,10 @@ which is the thesis's setting)::
     quality_gain = 0.0
 
 Unknown keys, wrong types and impossible values are refused with
-:class:`PlannerFileError` naming the file and the field.
+:class:`PlannerFileError` naming the file and the field; so is a file that is not UTF-8 text or
+TOML. The bounds are the search's (:mod:`contourgrasp.tolerances`): harmonics at most
+``MAX_HARMONICS``, lengths at most ``MAX_SEARCH_LENGTH``, friction at most ``MAX_FRICTION``, and
+a grid of at most ``MAX_GRID_POSES`` poses.
 """
 
 from __future__ import annotations
@@ -34,20 +37,23 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from ..errors import InputError
+from .. import tolerances as tol
+from ..errors import PlannerError
+from ..synthesis import SearchGrid
 from . import _toml_files
 
 _PRESET_DIR = "data/planners"
-#: Options that belong to perception (the rest are :func:`contourgrasp.synthesis.synthesize`'s).
+#: Options that belong to perception (the rest are :func:`contourgrasp.synthesis.search`'s).
 PERCEPTION_OPTIONS = ("depth_mode", "footprint")
 
-Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+Positive = Annotated[float, Field(gt=0, le=tol.MAX_SEARCH_LENGTH, allow_inf_nan=False)]
+Distance = Annotated[float, Field(ge=0, le=tol.MAX_SEARCH_LENGTH, allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
 
 
-class PlannerFileError(InputError):
+class PlannerFileError(PlannerError):
     """A planner file that cannot be read or does not follow the schema."""
 
 
@@ -56,25 +62,35 @@ class _PlannerSchema(BaseModel):
 
     name: str = Field(min_length=1)
     description: str = ""
-    harmonics: Annotated[int, Field(ge=1)] | Literal["adaptive"] | None = None
+    harmonics: Annotated[int, Field(ge=1, le=tol.MAX_HARMONICS)] | Literal["adaptive"] | None = None
     curvature: Literal["paper", "geometric"] | None = None
     xy_step: Positive | None = None
     yaw_step: Annotated[float, Field(gt=0, le=6.283185307179586, allow_inf_nan=False)] | None = None
-    d_max: NonNegative | Annotated[list[NonNegative], Field(min_length=2, max_length=2)] | None = None
-    d_min: NonNegative | None = None
+    d_max: Distance | Annotated[list[Distance], Field(min_length=2, max_length=2)] | None = None
+    d_min: Distance | None = None
     depth_mode: Literal["max", "plane"] | None = None
     footprint: bool | None = None
     refine: bool | None = None
     finger_thickness: bool | None = None
-    clearance: NonNegative | None = None
-    friction: NonNegative | None = None
+    clearance: Distance | None = None
+    friction: Annotated[float, Field(ge=0, le=tol.MAX_FRICTION, allow_inf_nan=False)] | None = None
     require_closure: bool | None = None
     quality_gain: NonNegative | None = None
+
+    @model_validator(mode="after")
+    def _grid_size(self):
+        """The grid's own checks (its size above all), with the search's defaults for what is unset."""
+        grid = {k: getattr(self, k) for k in ("xy_step", "yaw_step", "d_max", "d_min") if getattr(self, k) is not None}
+        try:
+            SearchGrid(**grid)
+        except PlannerError as err:
+            raise ValueError(str(err)) from None
+        return self
 
 
 @dataclass(frozen=True)
 class Planner:
-    """Named options of :func:`contourgrasp.pipeline.plan_grasp`.
+    """Named options of :func:`contourgrasp.pipeline.plan_frame`.
 
     Attributes
     ----------
@@ -90,17 +106,17 @@ class Planner:
 
     @property
     def plan_options(self) -> dict:
-        """Keyword options of :func:`contourgrasp.pipeline.plan_grasp`."""
+        """Keyword options of :func:`contourgrasp.pipeline.plan_frame`."""
         return dict(self.options)
 
     @property
     def synthesis_options(self) -> dict:
-        """Keyword options of :func:`contourgrasp.synthesis.synthesize` (perception's left out)."""
+        """Keyword options of :func:`contourgrasp.synthesis.search` (perception's left out)."""
         return synthesis_options(dict(self.options))
 
 
 def synthesis_options(options: dict) -> dict:
-    """The options of :func:`contourgrasp.pipeline.plan_grasp` that :func:`contourgrasp.synthesis.synthesize` takes."""
+    """The options of :func:`contourgrasp.pipeline.plan_frame` that :func:`contourgrasp.synthesis.search` takes."""
     return {k: v for k, v in options.items() if k not in PERCEPTION_OPTIONS}
 
 
@@ -142,7 +158,9 @@ def parse_planner(text: str, *, source: str = "<string>") -> Planner:
 def _describe(err: ValidationError) -> str:
     """The first validation error as 'field: message'."""
     first = err.errors()[0]
-    field = str(first["loc"][0]) if first["loc"] else "planner"
+    if not first["loc"]:  # the whole planner, e.g. a grid too large
+        return first["msg"].removeprefix("Value error, ")
+    field = str(first["loc"][0])
     if first["type"] == "extra_forbidden":
         return f"{field}: unknown key"
     if first["type"] == "missing":

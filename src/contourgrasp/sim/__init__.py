@@ -8,6 +8,7 @@
 * :mod:`~contourgrasp.sim.measure` -- fingertip paths against the preset
 * :mod:`~contourgrasp.sim.planners` -- the library's pipeline as trial planners, and two baselines
 * :mod:`~contourgrasp.sim.bench` -- Table 4.4 as a benchmark (``contourgrasp bench``), with its figures
+* :mod:`~contourgrasp.sim.calibrate` -- virtual starts from the simulated hand's closing
 
 Needs ``mujoco`` (4.x: ``mj_multiRay`` takes a ``normal`` argument), ``trimesh``
 and ``coacd``; nothing here uses OpenGL (``MUJOCO_GL`` defaults to ``disable``).
@@ -23,14 +24,15 @@ from .hand_model import TIMINGS, FingerTiming, HandDesign, HandModel, build_hand
 from .measure import fingertip_path_error, fingertip_paths
 from .objects import THESIS_OBJECTS, ObjectSpec, Part, mesh_object, object_spec
 from .render import DepthNoise, object_truth, render, render_view, tilted_view
-from .scene import Camera, Intrinsics, Placement, Scene, Workspace, build_scene
+from ..perception import Intrinsics
+from .scene import SR300, Camera, Placement, Scene, Workspace, build_scene
 from .trial import (DROPPED, FAILURE_CAUSES, NO_PLAN, PUSHED, SLIPPED, STRUCK, Execution, GraspOutcome, TrialRecord,
                     execute_grasp, hand_pose_from_matrix, pose_matrix, run_trial, scripted_grasp)
 
 __all__ = [
     "Camera", "DROPPED", "DepthNoise", "Execution", "FAILURE_CAUSES", "FingerTiming", "GraspOutcome", "HandDesign",
-    "HandModel", "Intrinsics", "NO_PLAN", "ObjectSpec", "PUSHED", "Part", "Placement", "SLIPPED", "STRUCK", "Scene",
-    "THESIS_OBJECTS", "TIMINGS", "TrialRecord", "Workspace", "build_hand", "build_scene", "execute_grasp",
+    "HandModel", "Intrinsics", "NO_PLAN", "ObjectSpec", "PUSHED", "Part", "Placement", "SLIPPED", "SR300", "STRUCK",
+    "Scene", "THESIS_OBJECTS", "TIMINGS", "TrialRecord", "Workspace", "build_hand", "build_scene", "execute_grasp",
     "fingertip_path_error", "fingertip_paths", "hand_pose_from_matrix", "mesh_object", "object_spec", "object_truth",
     "pose_matrix", "render", "render_view", "run_trial", "scripted_grasp", "tilted_view",
 ]

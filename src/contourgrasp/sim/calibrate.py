@@ -55,22 +55,15 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import SimulationError
 from ..hand import Hand
 from ..io.hand_file import load_hand
+from ..tolerances import CLOSED_WITHIN, CLOSING_TIE, FINGER_MOVED, TRAVEL_SAMPLES
 from .hand_model import HandDesign
 from .measure import fingertip_paths
 from .scene import TIMESTEP
 from .trial import Execution
 
-#: A fingertip this close to its full travel counts as closed, m: the soft joint limit lets it creep the rest.
-CLOSED_WITHIN = 5e-4
-#: A fingertip that has travelled this far has started to move, m.
-MOVED = 1e-3
-#: Closing times closer than this are a tie when choosing the reference finger (half a 2 ms step), s.
-TIE = 1e-3
-#: Contact distances per finger in the average over its travel (trapezoidal rule).
-TRAVEL_SAMPLES = 1001
 #: Decimals of a meter kept in calibrated virtual starts (0.1 mm): finer digits mean nothing to a 2-D hand model.
 DECIMALS = 4
 
@@ -99,10 +92,10 @@ class Closing:
         travel, times = np.asarray(self.travel, dtype=float), np.asarray(self.times, dtype=float)
         travelled = np.asarray(self.travelled, dtype=float)
         if travel.shape != (len(self.names),) or travelled.shape != (len(self.names), len(times)):
-            raise ValueError(f"closing of {len(self.names)} fingers needs travel (n,) and travelled (n, k), "
+            raise SimulationError(f"closing of {len(self.names)} fingers needs travel (n,) and travelled (n, k), "
                              f"got {travel.shape} and {travelled.shape} for {len(times)} times")
         if len(times) < 2 or times[0] != 0 or np.any(np.diff(times) <= 0):
-            raise ValueError("closing times must increase from 0")
+            raise SimulationError("closing times must increase from 0")
         object.__setattr__(self, "names", tuple(self.names))
         object.__setattr__(self, "travel", travel)
         object.__setattr__(self, "times", times)
@@ -123,25 +116,25 @@ class Closing:
 
     @property
     def closing_times(self) -> np.ndarray:
-        """(n,) float: time each finger reaches its full travel (within :data:`CLOSED_WITHIN`), s.
+        """(n,) float: time each finger reaches its full travel (within :data:`~contourgrasp.tolerances.CLOSED_WITHIN`), s.
 
         Raises
         ------
-        InputError
+        SimulationError
             A finger does not close that far while recorded.
         """
         closed = self.travel - CLOSED_WITHIN
         short = self.progress[:, -1] < closed
         if short.any():
             name = self.names[int(np.argmax(short))]
-            raise InputError(f"finger {name!r} does not close to within {CLOSED_WITHIN * 1e3:g} mm of its travel "
+            raise SimulationError(f"finger {name!r} does not close to within {CLOSED_WITHIN * 1e3:g} mm of its travel "
                              f"in {self.times[-1]:g} s")
         return np.array([self.arrival_times(i, c)[()] for i, c in enumerate(closed)])
 
     @property
     def start_times(self) -> np.ndarray:
-        """(n,) float: time each fingertip has moved :data:`MOVED`, s."""
-        return np.array([self.arrival_times(i, MOVED)[()] for i in range(len(self.names))])
+        """(n,) float: time each fingertip has moved :data:`~contourgrasp.tolerances.FINGER_MOVED`, s."""
+        return np.array([self.arrival_times(i, FINGER_MOVED)[()] for i in range(len(self.names))])
 
     @property
     def mean_speeds(self) -> np.ndarray:
@@ -174,7 +167,7 @@ def derive_virtual_starts(closing: Closing, *, reference: str | None = None) -> 
 
     Raises
     ------
-    InputError
+    SimulationError
         An unknown reference, or a finger that never closes (see :attr:`Closing.closing_times`).
     """
     r = _reference_index(closing, reference)
@@ -189,10 +182,10 @@ def derive_virtual_starts(closing: Closing, *, reference: str | None = None) -> 
 
 def _reference_index(closing: Closing, reference: str | None) -> int:
     closing_times = closing.closing_times  # also refuses a record in which some finger never closes
-    if reference is None:  # the first of the last, ties within TIE (mirror fingers such as ring and little)
-        return int(np.flatnonzero(closing_times >= closing_times.max() - TIE)[0])
+    if reference is None:  # the first of the last, ties within CLOSING_TIE (mirror fingers: ring and little)
+        return int(np.flatnonzero(closing_times >= closing_times.max() - CLOSING_TIE)[0])
     if reference not in closing.names:
-        raise InputError(f"reference finger {reference!r} is not one of {', '.join(closing.names)}")
+        raise SimulationError(f"reference finger {reference!r} is not one of {', '.join(closing.names)}")
     return closing.names.index(reference)
 
 
@@ -243,7 +236,7 @@ def measure_closing(hand, *, timing: str = "thesis", design: HandDesign = HandDe
 
     Raises
     ------
-    InputError
+    SimulationError
         A hand the simulation cannot build (arc fingers, unreachable travel, unknown timing).
     """
     hand = load_hand(hand)
@@ -277,7 +270,7 @@ def calibrate_virtual_starts(hand, *, reference: str | None = None, timing: str 
 
     Raises
     ------
-    InputError
+    SimulationError
         A hand the simulation cannot build, an unknown reference finger, or a
         finger that does not close fully.
     """

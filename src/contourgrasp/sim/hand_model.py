@@ -55,7 +55,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
-from ..errors import InputError
+from ..errors import SimulationError
 from ..hand import Hand, Ray
 
 #: Contact bits (contype/conaffinity): the table collides with hand and object,
@@ -80,7 +80,7 @@ class FingerTiming:
 
     def __post_init__(self):
         if not 0 <= self.start < self.end <= 1:
-            raise ValueError(f"finger timing needs 0 <= start < end <= 1, got {self.start}, {self.end}")
+            raise SimulationError(f"finger timing needs 0 <= start < end <= 1, got {self.start}, {self.end}")
 
 
 #: Closing schedules by name; fingers not listed close as ``"default"``.
@@ -292,17 +292,17 @@ def build_hand(hand: Hand, *, design: HandDesign = HandDesign(), timing: str = "
 
     Raises
     ------
-    InputError
+    SimulationError
         A finger closes on an arc, an unknown ``timing``, or a travel no finger
         of the design can reach.
     """
     if timing not in TIMINGS:
-        raise InputError(f"unknown finger timing {timing!r}; choose one of {', '.join(TIMINGS)}")
+        raise SimulationError(f"unknown finger timing {timing!r}; choose one of {', '.join(TIMINGS)}")
     schedule = TIMINGS[timing]
     fingers = []
     for finger in hand.fingers:
         if not isinstance(finger.trajectory, Ray):
-            raise InputError(f"hand {hand.name!r}: finger {finger.name!r} closes on an arc; "
+            raise SimulationError(f"hand {hand.name!r}: finger {finger.name!r} closes on an arc; "
                              "the simulated hand realises straight (ray) trajectories only")
         fingers.append(_finger_model(finger, design, schedule.get(finger.name, schedule["default"])))
     reach = [float(f.tip(np.linspace(0.0, 1.0, 201))[1].max()) for f in fingers]
@@ -362,7 +362,7 @@ def _flattest_swing(l1, l2, ratio, travel, name) -> tuple[float, float]:
     best = minimize_scalar(height_range, bounds=(0.0, np.pi / 4), method="bounded", options={"xatol": 1e-6})
     q1 = _closing_angle(l1, l2, best.x, ratio, travel)
     if q1 is None:
-        raise InputError(f"finger {name!r}: travel {travel} m is beyond the reach of a {l1 + l2:.3f} m finger")
+        raise SimulationError(f"finger {name!r}: travel {travel} m is beyond the reach of a {l1 + l2:.3f} m finger")
     return float(best.x), q1
 
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from .hand_model import HandDesign
+from ..errors import SimulationError
 from .scene import build_scene
 
 #: Palm height for free-space closing: fingertips far above the table and the object.
@@ -29,6 +30,11 @@ def fingertip_paths(hand="five-finger-linear", *, timing: str = "thesis", design
     dict of str to (k, 2) float
         Per finger, the fingertip at every time step (hand frame, m), from the
         open hand to ``hold_time`` after the force ramp ended.
+
+    Raises
+    ------
+    SimulationError
+        A hand the simulation cannot build, or whose simulation is unstable.
     """
     scene = build_scene("can", seed=0, hand=hand, design=design, timing=timing)
     model, data = scene.model, scene.data
@@ -42,6 +48,9 @@ def fingertip_paths(hand="five-finger-linear", *, timing: str = "thesis", design
         scene.step()
         position, rotation = scene.palm_pose()
         tracks.append((data.site_xpos[sites] - position) @ rotation)  # hand frame; drop z below
+    if scene.unstable:
+        raise SimulationError(f"hand {scene.hand.hand.name!r}: the simulated hand is unstable (NaN or huge "
+                              "accelerations): its fingers are too small or too large to simulate")
     paths = np.stack(tracks)[:, :, :2]
     return {f.name: paths[:, i] for i, f in enumerate(scene.hand.fingers)}
 

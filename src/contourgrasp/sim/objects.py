@@ -54,12 +54,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import SimulationError
+from ..tolerances import MESH_CONVEX, MESH_MAX_EXTENT
+from ..validation import choice, finite_array, positive
 
-#: A mesh whose largest extent exceeds this (m) is taken to be in millimetres.
-MAX_EXTENT = 1.0
-#: A mesh whose vertices all lie within this fraction of its size from its convex hull is convex enough.
-CONVEX_TOLERANCE = 0.02
 #: CoACD settings (fast rather than tight: a grasp needs the outline, not every dent).
 COACD_SETTINGS = {"threshold": 0.05, "preprocess_resolution": 30, "mcts_iterations": 60, "mcts_max_depth": 2,
                   "max_convex_hull": 16, "seed": 0}
@@ -94,10 +92,9 @@ class Part:
     faces: np.ndarray | None = None
 
     def __post_init__(self):
-        if self.kind not in (*_PRIMITIVES, "mesh"):
-            raise ValueError(f"unknown part kind {self.kind!r}")
+        choice("part kind", self.kind, (*_PRIMITIVES, "mesh"), error=SimulationError)
         if (self.kind == "mesh") != (self.vertices is not None):
-            raise ValueError("a mesh part needs vertices, a primitive none")
+            raise SimulationError("a mesh part needs vertices, a primitive none")
 
     def surface_points(self) -> np.ndarray:
         """(p, 3) float: points on (or spanning) the part's surface, object frame; for extents and resting height."""
@@ -138,9 +135,8 @@ class ObjectSpec:
 
     def __post_init__(self):
         if not self.collision:
-            raise ValueError(f"object {self.name!r} has no collision part")
-        if not self.mass > 0:
-            raise ValueError(f"object {self.name!r}: mass must be > 0")
+            raise SimulationError(f"object {self.name!r} has no collision part")
+        positive(f"object {self.name!r}: mass", self.mass, error=SimulationError)
 
     def points(self) -> np.ndarray:
         """(p, 3) float: surface points of the collision parts, object frame."""
@@ -247,16 +243,18 @@ def mesh_object(path, *, scale: float = 1.0, mass: float = 0.2, friction_hand: f
     """An object from an OBJ/STL/PLY mesh file: z up, units meters after ``scale``.
 
     The mesh is drawn as given and collides as its convex hull when it is
-    convex within :data:`CONVEX_TOLERANCE` of its size, else as the CoACD
+    convex within :data:`~contourgrasp.tolerances.MESH_CONVEX` of its size, else as the CoACD
     decomposition, cached under ``cache_dir`` (default
     ``$CONTOURGRASP_CACHE`` or ``~/.cache/contourgrasp``) keyed by the file's
     SHA-256, the scale and the CoACD settings.
 
     Raises
     ------
-    InputError
-        The file cannot be read as a mesh, is empty, or is larger than
-        :data:`MAX_EXTENT` (probably millimetres, or a missing ``scale``).
+    SimulationError
+        The file cannot be read as a mesh, is empty, has a non-finite vertex,
+        encloses no volume (a flat or degenerate mesh), or is larger than
+        :data:`~contourgrasp.tolerances.MESH_MAX_EXTENT` (probably millimetres,
+        or a missing ``scale``).
     """
     path = Path(path)
     mesh = _load_mesh(path, scale)
@@ -268,24 +266,53 @@ def mesh_object(path, *, scale: float = 1.0, mass: float = 0.2, friction_hand: f
 
 
 def _load_mesh(path: Path, scale: float):
-    import trimesh
-
-    try:
-        loaded = trimesh.load(path, force="mesh", process=True)
-    except Exception as err:  # trimesh raises many types for unreadable files
-        raise InputError(f"{path}: cannot read mesh ({type(err).__name__}: {err})") from None
-    if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
-        raise InputError(f"{path}: no triangles found in the mesh")
-    mesh = loaded.copy()
+    scale = positive("scale", scale, error=SimulationError)
+    _check_vertices(path, _read_mesh(path, process=False))  # processing silently drops non-finite vertices
+    mesh = _read_mesh(path, process=True).copy()
     mesh.apply_scale(scale)
     mesh.merge_vertices()
     extent = float(np.max(mesh.extents))
     if not np.isfinite(extent) or extent <= 0:
-        raise InputError(f"{path}: the mesh has no extent")
-    if extent > MAX_EXTENT:
-        raise InputError(f"{path}: the mesh is {extent:.3g} m across after scale {scale}: "
-                         f"probably millimetres (pass scale=0.001) or a missing scale")
+        raise SimulationError(f"{path}: the mesh has no extent")
+    if extent > MESH_MAX_EXTENT:
+        raise SimulationError(f"{path}: the mesh is {extent:.3g} m across after scale {scale}: "
+                              f"probably millimetres (pass scale=0.001) or a missing scale")
+    _check_volume(path, np.asarray(mesh.vertices))
     return mesh
+
+
+def _read_mesh(path: Path, *, process: bool):
+    import trimesh
+
+    try:
+        loaded = trimesh.load(path, force="mesh", process=process)
+    except Exception as err:  # trimesh raises many types for unreadable files
+        raise SimulationError(f"{path}: cannot read mesh ({type(err).__name__}: {err})") from None
+    if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
+        raise SimulationError(f"{path}: no triangles found in the mesh")
+    return loaded
+
+
+def _check_vertices(path: Path, mesh) -> None:
+    """Refuse a mesh with a NaN or infinite vertex coordinate, naming the first such vertex."""
+    try:
+        finite_array("vertices", mesh.vertices, (None, 3), error=SimulationError)
+    except SimulationError:
+        bad = int(np.flatnonzero(~np.isfinite(np.asarray(mesh.vertices, dtype=float)).all(axis=1))[0])
+        raise SimulationError(f"{path}: vertex {bad} is not finite ({mesh.vertices[bad].tolist()})") from None
+
+
+def _check_volume(path: Path, vertices: np.ndarray) -> None:
+    """Refuse a mesh whose vertices span no volume (one triangle, a flat sheet, a line): it cannot collide."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    try:
+        volume = ConvexHull(vertices).volume if len(vertices) >= 4 else 0.0
+    except QhullError:
+        volume = 0.0
+    if not volume > 0:
+        raise SimulationError(f"{path}: not a closed volume: its {len(vertices)} vertices are flat or degenerate "
+                              "(a collision mesh must enclose a volume)")
 
 
 def _rest_offset(vertices: np.ndarray) -> np.ndarray:
@@ -313,7 +340,7 @@ def hull_depth(vertices: np.ndarray, points: np.ndarray | None = None) -> float:
 def _convex_pieces(mesh, path: Path, scale: float, cache_dir) -> list[np.ndarray]:
     vertices = np.asarray(mesh.vertices)
     surface = np.vstack([vertices, mesh.triangles_center])
-    if hull_depth(vertices, surface) <= CONVEX_TOLERANCE * float(np.max(mesh.extents)):
+    if hull_depth(vertices, surface) <= MESH_CONVEX * float(np.max(mesh.extents)):
         return [vertices]
     cache = _cache_file(path, scale, cache_dir)
     if cache.exists():

@@ -8,14 +8,14 @@ here also has ``plan(rgb, depth, intrinsics) -> PlannedGrasp``, the same
 answer with what it saw (for figures).
 
 Synthesis planners (:func:`synthesis_planner`)
-    :func:`contourgrasp.pipeline.plan_grasp` -- exactly the path a user's camera
+    :func:`contourgrasp.pipeline.plan_frame` -- exactly the path a user's camera
     frames take -- with a planner's options: a preset of
     :mod:`contourgrasp.io.planner_file` (``paper``, ``default``), a planner TOML
     file, or a step of the ablation from ``paper`` to ``default``
     (:func:`ablation_planners`).
 
 Baselines (:data:`BASELINES`), to show whether the bench tells good from bad
-    Both use the same perception as ``plan_grasp`` (:func:`perceive`) and no synthesis.
+    Both use the same perception as ``plan_frame`` (:func:`contourgrasp.pipeline.perceive`) and no synthesis.
 
     ``centroid-principal-axis``
         The hand's grasp centre (:attr:`~contourgrasp.hand.Hand.grasp_centre`,
@@ -42,8 +42,9 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from .. import efd, perception, pipeline, synthesis
-from ..errors import InputError, NoFeasibleGrasp
+from .. import contour as efd
+from .. import perception, pipeline, synthesis
+from ..errors import HandError, NoFeasibleGrasp, SimulationError
 from ..hand import Hand, Ray, to_image
 from ..io.planner_file import Planner, load_planner, planner_names
 
@@ -96,12 +97,6 @@ class PlannedGrasp:
     plan: synthesis.GraspPlan | None
 
 
-def camera_intrinsics(intrinsics) -> perception.Intrinsics:
-    """The library's intrinsics of the simulated camera's (its depth range is applied by the renderer)."""
-    return perception.Intrinsics(intrinsics.fx, intrinsics.fy, intrinsics.cx, intrinsics.cy, intrinsics.width,
-                                 intrinsics.height)
-
-
 @dataclass(frozen=True)
 class _Planner:
     """Base of the planners: ``__call__`` is the trial's planner interface over the subclass's ``plan``."""
@@ -115,12 +110,12 @@ class _Planner:
 
 @dataclass(frozen=True)
 class SynthesisPlanner(_Planner):
-    """:func:`contourgrasp.pipeline.plan_grasp` with fixed options ((name, value) pairs)."""
+    """:func:`contourgrasp.pipeline.plan_frame` with fixed options ((name, value) pairs)."""
 
     options: tuple[tuple[str, object], ...] = ()
 
     def plan(self, rgb, depth, intrinsics) -> PlannedGrasp:
-        result = pipeline.plan_grasp(rgb, depth, camera_intrinsics(intrinsics), self.hand, **dict(self.options))
+        result = pipeline.plan_frame(rgb, depth, intrinsics, self.hand, **dict(self.options))
         return PlannedGrasp(result.plan.pose, result.T_camera_hand, result.metric.approach_depth,
                             result.segmentation, result.metric, result.camera, result.plan)
 
@@ -130,9 +125,8 @@ class CentroidPlanner(_Planner):
     """The ``centroid-principal-axis`` baseline (module docstring)."""
 
     def plan(self, rgb, depth, intrinsics) -> PlannedGrasp:
-        camera = camera_intrinsics(intrinsics)
-        segmentation, metric = perceive(rgb, depth, camera)
-        return _planned(centroid_pose(metric.contour_xy, self.hand), segmentation, metric, camera)
+        segmentation, metric, _ = pipeline.perceive(rgb, depth, intrinsics)
+        return _planned(centroid_pose(metric.contour_xy, self.hand), segmentation, metric, intrinsics)
 
 
 @dataclass(frozen=True)
@@ -142,11 +136,10 @@ class RandomPlanner(_Planner):
     seed: int = 0
 
     def plan(self, rgb, depth, intrinsics) -> PlannedGrasp:
-        camera = camera_intrinsics(intrinsics)
-        segmentation, metric = perceive(rgb, depth, camera)
+        segmentation, metric, _ = pipeline.perceive(rgb, depth, intrinsics)
         rng = np.random.default_rng([self.seed, 2])  # streams 0 and 1 place the object and add noise
         pose = random_feasible_pose(metric.contour_xy, self.hand, rng, search_settings(RANDOM_REGION))
-        return _planned(pose, segmentation, metric, camera)
+        return _planned(pose, segmentation, metric, intrinsics)
 
 
 def ablation_planners() -> tuple[Planner, ...]:
@@ -174,7 +167,7 @@ def synthesis_planner(name: str) -> Planner | None:
 
     Raises
     ------
-    InputError
+    SimulationError
         A name that is none of these (or a planner file that does not load).
     """
     if name in BASELINES:
@@ -186,7 +179,7 @@ def synthesis_planner(name: str) -> Planner | None:
         return steps[name]
     if Path(name).suffix == ".toml":
         return load_planner(name)
-    raise InputError(f"unknown planner {name!r}: choose from {', '.join(PLANNER_NAMES)}, an ablation step "
+    raise SimulationError(f"unknown planner {name!r}: choose from {', '.join(PLANNER_NAMES)}, an ablation step "
                      f"({', '.join(steps)}) or a planner .toml file")
 
 
@@ -195,7 +188,7 @@ def make_planner(name: str, hand: Hand, *, seed: int = 0) -> _Planner:
 
     Raises
     ------
-    InputError
+    SimulationError
         Unknown name.
     """
     planner = synthesis_planner(name)
@@ -209,9 +202,9 @@ def make_planner(name: str, hand: Hand, *, seed: int = 0) -> _Planner:
 
 
 def library_defaults(names) -> dict:
-    """The defaults of the options ``names`` of :func:`contourgrasp.pipeline.plan_grasp` and of synthesis."""
+    """The defaults of the options ``names`` of :func:`contourgrasp.pipeline.plan_frame` and of synthesis."""
     defaults = {}
-    for function in (pipeline.plan_grasp, synthesis.synthesize):
+    for function in (pipeline.plan_frame, synthesis.search):
         for name, parameter in inspect.signature(function).parameters.items():
             if name in names and parameter.default is not inspect.Parameter.empty:
                 defaults[name] = parameter.default
@@ -226,17 +219,11 @@ def search_settings(name: str) -> dict:
     return {"harmonics": options["harmonics"], "curvature": options["curvature"], "grid": grid}
 
 
-def perceive(rgb, depth, intrinsics: perception.Intrinsics):
-    """The perception of :func:`contourgrasp.pipeline.plan_grasp` with its defaults: (Segmentation, MetricContour)."""
-    segmentation, metric, _ = pipeline.perceive(rgb, depth, intrinsics)
-    return segmentation, metric
-
-
 def centroid_pose(contour_xy, hand: Hand) -> np.ndarray:
     """(3,) float: the pose putting ``hand.grasp_centre`` on the polygon's centroid, thumb along its minor axis."""
     moments = cv2.moments(np.asarray(contour_xy, dtype=np.float32))
     if moments["m00"] == 0:
-        raise InputError("the contour encloses no area")
+        raise SimulationError("the contour encloses no area")
     centroid = np.array([moments["m10"], moments["m01"]]) / moments["m00"]
     covariance = np.array([[moments["mu20"], moments["mu11"]], [moments["mu11"], moments["mu02"]]])
     minor = np.linalg.eigh(covariance)[1][:, 0]  # eigenvalues ascending
@@ -251,7 +238,7 @@ def _thumb_direction(hand: Hand) -> tuple[float, float]:
     """Closing direction of the first required finger (the thumb), else of the first finger."""
     finger = next((f for f in hand.fingers if f.required), hand.fingers[0])
     if not isinstance(finger.trajectory, Ray):
-        raise InputError(f"hand {hand.name!r}: the centroid baseline needs a thumb that closes on a ray")
+        raise HandError(f"hand {hand.name!r}: the centroid baseline needs a thumb that closes on a ray")
     return finger.trajectory.closing_direction
 
 
@@ -259,7 +246,7 @@ def random_feasible_pose(contour_xy, hand: Hand, rng: np.random.Generator, setti
     """(3,) float: a pose uniform over the search region's feasible poses (rejection sampling).
 
     ``settings`` is :func:`search_settings`'s: the region is the grid's x and y
-    extent around the EFD locus (as :func:`~contourgrasp.synthesis.synthesize`
+    extent around the EFD locus (as :func:`~contourgrasp.synthesis.search`
     would search it) and any yaw; feasibility is
     :func:`~contourgrasp.synthesis.evaluate_poses`'s with the grid's D_min.
 

@@ -23,7 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .scene import R_WORLD_CAMERA, Intrinsics, Scene, mujoco
+from ..perception import Intrinsics
+from .scene import R_WORLD_CAMERA, Scene, mujoco
 
 #: Geom groups the camera sees: table and objects (0) and objects' drawn meshes (1), not the hand (2)
 #: nor collision-only pieces (3).
@@ -78,12 +79,12 @@ def render(scene: Scene, *, noise: DepthNoise | bool = False, seed: int = 0,
     depth : (H, W) float32
         Meters along the optical axis; 0 where nothing is hit or out of range.
     """
-    intr = scene.camera.intrinsics
+    depth_min, depth_max = scene.camera.depth_range
     eye, R_world_camera = _view(scene, view)
-    rgb, depth, _ = _cast(scene, eye, R_world_camera, intr, show_hand, 2 * intr.depth_max)
+    rgb, depth, _ = _cast(scene, eye, R_world_camera, scene.camera.intrinsics, show_hand, 2 * depth_max)
     if noise:
         depth = _noisy(depth, DepthNoise() if noise is True else noise, np.random.default_rng([seed, 1]))
-    depth = np.where((depth >= intr.depth_min) & (depth <= intr.depth_max), depth, 0.0)
+    depth = np.where((depth >= depth_min) & (depth <= depth_max), depth, 0.0)
     return rgb, depth.astype(np.float32)
 
 
@@ -152,7 +153,7 @@ def object_truth(scene: Scene, view=None) -> tuple[np.ndarray, np.ndarray]:
     _, _, geom = _cast(scene, eye, R_world_camera, intr, False, VIEW_RANGE)
     obj = scene.model.body("object").id
     seen = (geom >= 0) & (scene.model.geom_bodyid[np.maximum(geom, 0)] == obj)
-    rays = intr.rays().reshape(-1, 3) @ R_world_camera.T
+    rays = pixel_rays(intr).reshape(-1, 3) @ R_world_camera.T
     with np.errstate(divide="ignore", invalid="ignore"):
         on_table = eye - (eye[2] / rays[:, 2])[:, None] * rays
     # Only table points within the object's plan extent (with a margin for drawn meshes) need a vertical ray.
@@ -167,6 +168,12 @@ def object_truth(scene: Scene, view=None) -> tuple[np.ndarray, np.ndarray]:
         mujoco.mj_ray(scene.model, scene.data, start, down, groups, 1, -1, hit)
         footprint[i] = hit[0] >= 0 and scene.model.geom_bodyid[hit[0]] == obj
     return seen, footprint.reshape(seen.shape)
+
+
+def pixel_rays(intrinsics: Intrinsics) -> np.ndarray:
+    """(height, width, 3) float: per pixel centre, the ray direction with unit z (camera frame)."""
+    u, v = np.meshgrid(np.arange(intrinsics.width, dtype=float), np.arange(intrinsics.height, dtype=float))
+    return intrinsics.rays(np.stack([u, v], axis=-1)).reshape(intrinsics.height, intrinsics.width, 3)
 
 
 def _view(scene: Scene, view):
@@ -184,7 +191,7 @@ def _groups(show_hand: bool) -> np.ndarray:
 
 def _cast(scene: Scene, eye, R_world_camera, intr: Intrinsics, show_hand: bool, max_distance: float):
     """Colour (H, W, 3) uint8, depth along the optical axis (H, W) float (0: no hit) and geom hit (H, W) int (-1: none)."""
-    rays_world = np.ascontiguousarray(intr.rays().reshape(-1, 3) @ np.asarray(R_world_camera).T)
+    rays_world = np.ascontiguousarray(pixel_rays(intr).reshape(-1, 3) @ np.asarray(R_world_camera).T)
     n = len(rays_world)
     geom = np.empty(n, dtype=np.int32)
     dist = np.empty(n, dtype=np.float64)

@@ -23,6 +23,7 @@ makes grasps hold in MuJoCo: elliptic friction cones, ``impratio`` 10, the
 
 from __future__ import annotations
 
+import contextlib
 import os
 from dataclasses import dataclass, field
 
@@ -32,7 +33,9 @@ os.environ.setdefault("MUJOCO_GL", "disable")  # we only ray-cast; never load an
 import mujoco  # noqa: E402
 
 from ..hand import Hand  # noqa: E402
+from ..perception import Intrinsics  # noqa: E402
 from ..io.hand_file import load_hand  # noqa: E402
+from ..tolerances import SENSOR_RANGE  # noqa: E402
 from .hand_model import HAND_BIT, TABLE_BIT, HandDesign, HandModel, build_hand  # noqa: E402
 from .objects import ObjectSpec, Part, object_spec  # noqa: E402
 
@@ -48,52 +51,29 @@ ROLLING = 0.0005
 R_WORLD_CAMERA = np.diag([1.0, -1.0, -1.0])
 
 
-@dataclass(frozen=True)
-class Intrinsics:
-    """Pinhole intrinsics and the depth sensor's range.
-
-    Defaults: an Intel RealSense SR300 depth stream at 640 x 480 as librealsense
-    reports it (fx = fy = 472.95 px, principal point (310.21, 245.26), ~68 x 54
-    degrees), with the thesis's range 0.2-1.5 m (4.1.2). Colour is rendered
-    registered to depth, as the thesis uses both in one pixel grid.
-
-    Attributes
-    ----------
-    fx, fy : float
-        Focal lengths in pixels.
-    cx, cy : float
-        Principal point, pixels from the left / top edge.
-    width, height : int
-    depth_min, depth_max : float
-        Readings outside this range are missing (0), m.
-    """
-
-    fx: float = 472.95
-    fy: float = 472.95
-    cx: float = 310.21
-    cy: float = 245.26
-    width: int = 640
-    height: int = 480
-    depth_min: float = 0.2
-    depth_max: float = 1.5
-
-    @property
-    def matrix(self) -> np.ndarray:
-        """(3, 3) float: K = [[fx, 0, cx], [0, fy, cy], [0, 0, 1]]."""
-        return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
-
-    def rays(self) -> np.ndarray:
-        """(height, width, 3) float: per pixel centre, the ray direction with unit z (camera frame)."""
-        u, v = np.meshgrid(np.arange(self.width, dtype=float), np.arange(self.height, dtype=float))
-        return np.stack([(u - self.cx) / self.fx, (v - self.cy) / self.fy, np.ones_like(u)], axis=-1)
+#: The simulated camera: an Intel RealSense SR300 depth stream at 640 x 480 as librealsense reports it
+#: (fx = fy = 472.95 px, principal point (310.21, 245.26), ~68 x 54 degrees). Colour is rendered
+#: registered to depth, as the thesis uses both in one pixel grid.
+SR300 = Intrinsics(fx=472.95, fy=472.95, cx=310.21, cy=245.26, width=640, height=480)
 
 
 @dataclass(frozen=True)
 class Camera:
-    """A camera looking straight down from ``height`` m above the table at the world origin."""
+    """A camera looking straight down from ``height`` m above the table at the world origin.
+
+    Attributes
+    ----------
+    height : float
+        Of the optical centre above the table, m.
+    intrinsics : contourgrasp.perception.Intrinsics
+        Default :data:`SR300`.
+    depth_range : (float, float)
+        Readings outside this range are missing (0), m; default the thesis's sensor range 0.2-1.5 m (4.1.2).
+    """
 
     height: float = 0.65
-    intrinsics: Intrinsics = field(default_factory=Intrinsics)
+    intrinsics: Intrinsics = SR300
+    depth_range: tuple[float, float] = SENSOR_RANGE
 
     @property
     def position(self) -> np.ndarray:
@@ -176,7 +156,8 @@ class Scene:
         self.data.qpos[self._base_qpos] = target
         self.data.qvel[self._base_dofs] = 0.0
         self.command(target, closing)
-        mujoco.mj_forward(self.model, self.data)
+        with mujoco_warnings():
+            mujoco.mj_forward(self.model, self.data)
 
     def command(self, base_target, closing: float) -> None:
         """Servo targets for the hand base (x, y, z, yaw) and the tendon force fraction."""
@@ -186,10 +167,41 @@ class Scene:
     def step(self, duration: float | None = None) -> None:
         """Advance the simulation by ``duration`` s (one time step if None) at the current commands."""
         steps = 1 if duration is None else max(1, round(duration / self.model.opt.timestep))
-        mujoco.mj_step(self.model, self.data, nstep=steps)
+        with mujoco_warnings():
+            mujoco.mj_step(self.model, self.data, nstep=steps)
+
+    @property
+    def unstable(self) -> bool:
+        """Whether MuJoCo found NaN, infinite or huge accelerations (and reset the state) at some step."""
+        return self.data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number > 0
 
 
 BASE_JOINTS = ("hand_x", "hand_y", "hand_z", "hand_yaw")
+
+
+@contextlib.contextmanager
+def mujoco_warnings():
+    """Route MuJoCo's warnings away from its default handler, which appends them to ``MUJOCO_LOG.TXT``.
+
+    Without a user handler MuJoCo writes that file into the working directory
+    on any warning (an unstable simulation, a full contact buffer). Inside this
+    block the warnings are dropped; MuJoCo still counts them in
+    ``MjData.warning``, which :attr:`Scene.unstable` reads. A handler the caller
+    installed is left in place.
+    """
+    previous = mujoco.get_mju_user_warning()
+    if previous is not None:
+        yield
+        return
+    mujoco.set_mju_user_warning(_ignore)
+    try:
+        yield
+    finally:
+        mujoco.set_mju_user_warning(None)
+
+
+def _ignore(message: str) -> None:
+    """The warning handler of :func:`mujoco_warnings`: MuJoCo's own counters keep the record."""
 
 
 def build_scene(obj, *, seed: int, hand: Hand | str = "five-finger-linear", design: HandDesign = HandDesign(),
@@ -215,8 +227,9 @@ def build_scene(obj, *, seed: int, hand: Hand | str = "five-finger-linear", desi
     placement = Placement(x=float(rng.uniform(-workspace.half_x, workspace.half_x)),
                           y=float(rng.uniform(-workspace.half_y, workspace.half_y)),
                           yaw=float(rng.uniform(0.0, 2 * np.pi)))
-    model = mujoco.MjModel.from_xml_string(scene_xml(obj, hand_model, placement))
-    data = mujoco.MjData(model)
+    with mujoco_warnings():
+        model = mujoco.MjModel.from_xml_string(scene_xml(obj, hand_model, placement))
+        data = mujoco.MjData(model)
     scene = Scene(model, data, obj, hand_model, camera, placement)
     scene.set_hand(0.0, 0.0, PARK_HEIGHT, 0.0)
     scene.step(SETTLE_TIME)

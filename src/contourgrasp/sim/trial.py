@@ -46,7 +46,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from ..errors import InputError, NoFeasibleGrasp
+from ..errors import InputError, NoFeasibleGrasp, SimulationError
 from ..hand import Hand
 from .hand_model import HandDesign
 from .render import render
@@ -179,7 +179,7 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
     planner : callable
         ``planner(rgb, depth, intrinsics) -> (T_camera_hand, approach_depth)``:
         ``rgb`` (H, W, 3) uint8, ``depth`` (H, W) float32 m (0 = missing),
-        ``intrinsics`` :class:`~contourgrasp.sim.scene.Intrinsics`; returns the
+        ``intrinsics`` :class:`~contourgrasp.perception.Intrinsics`; returns the
         (4, 4) hand pose in the camera frame (see :func:`hand_pose_from_matrix`)
         and the approach depth (m). It may raise ``NoFeasibleGrasp`` or
         ``InputError`` when it has no plan.
@@ -228,15 +228,15 @@ def hand_pose_from_matrix(transform) -> tuple[float, float, float]:
 
     Raises
     ------
-    InputError
+    SimulationError
         Not a (4, 4) rigid transform with its z axis along the camera's.
     """
     t = np.asarray(transform, dtype=float)
     if t.shape != (4, 4) or not np.all(np.isfinite(t)):
-        raise InputError(f"T_camera_hand must be a finite (4, 4) matrix, got shape {t.shape}")
+        raise SimulationError(f"T_camera_hand must be a finite (4, 4) matrix, got shape {t.shape}")
     rotation = t[:3, :3]
     if not np.allclose(rotation.T @ rotation, np.eye(3), atol=1e-6) or t[2, 2] < 1 - 1e-6:
-        raise InputError("T_camera_hand must be a rotation about the camera's z axis (palm facing the table)")
+        raise SimulationError("T_camera_hand must be a rotation about the camera's z axis (palm facing the table)")
     return float(t[0, 3]), float(t[1, 3]), math.atan2(t[1, 0], t[0, 0])
 
 
@@ -384,7 +384,7 @@ def scripted_grasp(scene: Scene, kind: str = "good") -> tuple[np.ndarray, float]
     top plus 1 cm, as the test planner does.
     """
     if kind not in ("good", "bad"):
-        raise InputError(f"scripted grasp kind must be 'good' or 'bad', got {kind!r}")
+        raise SimulationError(f"scripted grasp kind must be 'good' or 'bad', got {kind!r}")
     hand = scene.hand.hand
     rotation_world = scene.data.xmat[scene.model.body("object").id].reshape(3, 3)
     axis = scene.camera.from_world(scene.camera.position + rotation_world[:, 0])[:2]

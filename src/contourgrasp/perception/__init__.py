@@ -1,0 +1,42 @@
+"""Perception: the object's contour and approach depth from one RGB-D frame (thesis 3.1, 3.1.1).
+
+Every function here works on arrays; reading files is :mod:`contourgrasp.io.camera_file`'s job.
+One module per stage, in the order the pipeline runs them:
+
+* :mod:`~contourgrasp.perception.camera` -- intrinsics, depth images (validity, hole filling,
+  denoising for nearest points), points of pixels, colour images
+* :mod:`~contourgrasp.perception.table` -- the table plane (RANSAC), heights above it
+* :mod:`~contourgrasp.perception.region` -- picking the object's region in a mask, its outline,
+  :class:`Segmentation`
+* :mod:`~contourgrasp.perception.segment_rgb` -- the thesis's RGB steps (3.1)
+* :mod:`~contourgrasp.perception.segment_depth` -- the region above the table, its footprint
+* :mod:`~contourgrasp.perception.colour` -- colour-depth registration, flat parts found by colour
+* :mod:`~contourgrasp.perception.segmentation` -- :func:`segment` (the methods and the ``"auto"``
+  rule), a user's mask
+* :mod:`~contourgrasp.perception.metric` -- pixels to meters in the planning plane (eq 3.1-3.2),
+  the approach depth (3.1.1)
+
+Conventions: see :mod:`~contourgrasp.perception.camera`. The thresholds are in
+:mod:`contourgrasp.tolerances`; measured results (IoU against the hand-made
+masks, timings) in the README's "Perception" section and ``benchmarks/``.
+"""
+
+from __future__ import annotations
+
+from ..errors import PerceptionError, PerceptionWarning, SegmentationError
+from .camera import Intrinsics, as_depth, backproject, denoised_depth, fill_depth_holes, valid_depth
+from .colour import add_flat_parts, colour_offset, register_colour
+from .metric import DEPTH_MODES, DepthMode, MetricContour, approach_depth, contour_to_metric
+from .region import Segmentation, mask_contour
+from .segment_depth import object_footprint, segment_depth
+from .segment_rgb import segment_rgb
+from .segmentation import SEGMENT_METHODS, SegmentMethod, segment, segment_from_mask
+from .table import Plane, fit_plane, fit_table_plane
+
+__all__ = [
+    "DEPTH_MODES", "DepthMode", "Intrinsics", "MetricContour", "PerceptionError", "PerceptionWarning", "Plane",
+    "SEGMENT_METHODS", "SegmentMethod", "Segmentation", "SegmentationError", "add_flat_parts", "approach_depth",
+    "as_depth", "backproject", "colour_offset", "contour_to_metric", "denoised_depth", "fill_depth_holes",
+    "fit_plane", "fit_table_plane", "mask_contour", "object_footprint", "register_colour", "segment",
+    "segment_depth", "segment_from_mask", "segment_rgb", "valid_depth",
+]

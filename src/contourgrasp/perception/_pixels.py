@@ -1,0 +1,64 @@
+"""Small helpers on masks and pixels shared by the perception stages: boxes, morphology, connectivity."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+
+def connected_to(region, mask):
+    """(H, W) bool: the 8-connected parts of ``region`` that hold a pixel of ``mask`` (a subset of it)."""
+    count, labels = cv2.connectedComponents(region.astype(np.uint8), connectivity=8)
+    keep = np.zeros(count, dtype=bool)
+    keep[labels[mask]] = True
+    return keep[labels]
+
+
+def disc(radius):
+    """OpenCV's elliptic structuring element of ``radius`` px."""
+    return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 1, 2 * radius + 1))
+
+
+def dilate(mask, radius):
+    """(H, W) bool: ``mask`` dilated by a disc of ``radius`` px."""
+    return morph(cv2.MORPH_DILATE, mask, radius)
+
+
+def opening(mask, radius):
+    """(H, W) bool: ``mask`` opened by a disc of ``radius`` px (drops parts thinner than the disc)."""
+    return morph(cv2.MORPH_OPEN, mask, radius)
+
+
+def morph(operation, mask, radius):
+    """(H, W) bool: ``mask`` dilated or opened by a disc, as OpenCV does it on the whole image.
+
+    The operation runs on the mask's bounding box grown by ``radius`` only: the
+    result is empty farther out, and within the box every disc around a mask
+    pixel is inside it (or beyond the image's edge, as on the whole image).
+    """
+    out = np.zeros(mask.shape, dtype=bool)
+    if mask.any():
+        box = grown_box(mask, radius)
+        out[box] = cv2.morphologyEx(mask[box].astype(np.uint8), operation, disc(radius)) > 0
+    return out
+
+
+def grown_box(mask, margin):
+    """(rows, cols) slices of ``mask``'s bounding box grown by ``margin`` px, within the image; ``mask`` is not empty."""
+    return pixel_box(np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0)), margin, mask.shape)
+
+
+def pixel_box(rows, cols, margin, shape):
+    """(rows, cols) slices of the bounding box of the pixels (rows, cols), not empty, grown by ``margin`` px,
+    within an image of ``shape``."""
+    return (slice(max(rows.min() - margin, 0), min(rows.max() + margin + 1, shape[0])),
+            slice(max(cols.min() - margin, 0), min(cols.max() + margin + 1, shape[1])))
+
+
+def in_image(uv, shape):
+    """Which of the (n, 2) float pixels round to a pixel of an image of ``shape``, and their columns and rows."""
+    seen = np.isfinite(uv).all(axis=1)
+    u, v = np.zeros(len(uv), dtype=int), np.zeros(len(uv), dtype=int)
+    u[seen], v[seen] = np.rint(uv[seen]).astype(int).T
+    seen &= (u >= 0) & (u < shape[1]) & (v >= 0) & (v < shape[0])
+    return seen, u, v

@@ -1,0 +1,249 @@
+"""Colour with depth: the colour-depth registration, and the object's parts too flat for depth to see.
+
+Colour-depth registration. The shared PrimeSense pairs are sold as registered,
+but an object's outline in depth lies a few pixels above its outline in colour
+(README, "Perception"). So ``"auto"`` segmentation first finds that shift where
+the object is (:func:`colour_offset`, edge correlation) and moves the colour
+image onto the depth image (:func:`register_colour`) before it looks for flat
+parts (:func:`add_flat_parts`); masks and contours stay in depth pixels (the
+shift is in ``Segmentation.colour_offset_px``).
+
+Flat parts. Depth misses the parts of an object lower than ``min_height`` (a
+can opener lying flat: depth sees only its raised grip). The pixels unlike the
+table's colour connected to the depth mask are its candidates, of which only
+the parts more than ``HALO_PX`` beyond the depth outline and of at least
+``min_area_px`` are added: nearer colour evidence is shadow and the object's
+side, which the depth outline bounds better.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import cv2
+import numpy as np
+
+from .. import validation
+from ..errors import PerceptionError
+from ..tolerances import (COLOUR_DISTANCE, EVIDENCE_OPEN_PX, FLAT_WINDOW_PX, HALO_PX, LIGHTNESS_WEIGHT,
+                          MAX_COLOUR_OFFSET_PX, MIN_AREA_PX, REGISTRATION_MARGIN_PX, SHADOW_LIGHTNESS)
+from ._pixels import connected_to, dilate, grown_box, opening
+from .camera import as_depth, as_rgb
+from .region import Segmentation, make_segmentation, pick_object
+
+
+def add_flat_parts(
+    rgb,
+    seg: Segmentation,
+    *,
+    colour_distance: float = COLOUR_DISTANCE,
+    lightness_weight: float = LIGHTNESS_WEIGHT,
+    shadow_lightness: float = SHADOW_LIGHTNESS,
+    halo_px: int = HALO_PX,
+    min_area_px: int = MIN_AREA_PX,
+) -> Segmentation:
+    """Add to a depth segmentation the parts of the object too flat for depth to see.
+
+    1. Colour evidence: the pixels whose colour is more than
+       ``colour_distance`` from the table's, or whose lightness is below
+       ``shadow_lightness`` times the table's, opened with a 5 x 5 element to
+       drop thin straps and specks, and connected to the depth mask. The
+       table's colour is the median CIELAB colour of the table-plane inliers
+       ``halo_px`` to ``4 * halo_px`` pixels around the depth mask; the
+       distance weighs lightness by ``lightness_weight``, because a shadow on
+       the table changes its lightness far more than its hue. A dark grey
+       part on a light grey table differs in lightness only, hence the second
+       test: no soft shadow is that dark.
+    2. Flat parts: the colour evidence farther than ``halo_px`` from the depth
+       mask, in pieces of at least ``min_area_px``. Nearer evidence is the
+       band of shadow and the object's side seen by a tilted camera, which
+       the depth outline already bounds better, and is ignored.
+    3. The flat parts (with the colour evidence within ``halo_px`` of them,
+       which joins them to the rest) are added to the depth mask, and the
+       object is picked again as in the other methods (largest region not
+       touching the image border, holes filled).
+
+    Without flat parts the depth segmentation is returned unchanged.
+
+    :func:`segment` calls this on the region seen above the table
+    (``segment_depth(footprint=False)``) with the colour image registered to
+    the depth image (:func:`register_colour`), and takes the footprint of the
+    result afterwards.
+
+    Parameters
+    ----------
+    rgb : (H, W, 3) uint8
+        Colour image in RGB order, registered to the depth image, or (H, W) uint8 grayscale.
+    seg : Segmentation
+        From :func:`segment_depth` (it needs the table ``plane``), best without the footprint.
+    colour_distance : float
+        Euclidean distance in OpenCV's 8-bit CIELAB (L scaled to 0-255), after
+        the lightness is multiplied by ``lightness_weight``.
+    lightness_weight : float
+        Weight of the lightness difference, 0-1.
+    shadow_lightness : float
+        Fraction of the table's lightness below which a pixel is object, 0-1 (0: no such test).
+    halo_px : int
+        As above, pixels.
+    min_area_px : int
+        Smallest flat part and smallest object, pixels.
+
+    Returns
+    -------
+    Segmentation
+        Method ``"depth+rgb"`` when flat parts were added, else ``seg``.
+
+    Raises
+    ------
+    SegmentationError
+        Kind ``"not-visible"`` when the grown object touches the image border.
+    """
+    image = as_rgb(rgb)
+    validation.same_size(image.shape, seg.mask.shape, "rgb image", "mask", error=PerceptionError)
+    colour_distance = validation.positive("colour_distance", colour_distance, error=PerceptionError)
+    lightness_weight = validation.fraction("lightness_weight", lightness_weight, error=PerceptionError)
+    shadow_lightness = validation.fraction("shadow_lightness", shadow_lightness, error=PerceptionError)
+    halo_px = validation.integer("halo_px", halo_px, 1, error=PerceptionError)
+    min_area_px = validation.integer("min_area_px", min_area_px, 1, error=PerceptionError)
+    if seg.plane is None or seg.plane.inliers.shape != seg.mask.shape:
+        raise PerceptionError("add_flat_parts needs a depth segmentation with its table plane")
+    halo = dilate(seg.mask, halo_px)
+    unlike = _unlike_table(image, seg.mask, halo, seg.plane.inliers, colour_distance, lightness_weight,
+                           shadow_lightness, halo_px)
+    _, labels, stats, _ = cv2.connectedComponentsWithStats((unlike & ~halo).astype(np.uint8), connectivity=8)
+    large = stats[:, cv2.CC_STAT_AREA] >= min_area_px
+    large[0] = False
+    flat = large[labels]
+    if not flat.any():
+        return seg
+    grown = seg.mask | (unlike & dilate(flat, halo_px))
+    mask, notes = pick_object(grown, np.zeros(grown.shape, dtype=bool), min_area_px, "in the depth and colour masks")
+    result = make_segmentation("depth+rgb", mask, notes, plane=seg.plane, filled_px=seg.filled_px, on_table=seg.on_table)
+    return replace(result, warnings=(*seg.warnings, *result.warnings))
+
+
+def _unlike_table(image, depth_mask, halo, table, colour_distance, lightness_weight, shadow_lightness, halo_px):
+    """(H, W) bool: pixels of a colour unlike the table's, opened, connected to ``depth_mask`` (without it).
+
+    ``halo`` is the depth mask dilated by ``halo_px``. The work is done in a
+    window ``FLAT_WINDOW_PX`` beyond the table ring around the depth mask (a
+    fraction of the frame), and again on the whole image only when the
+    evidence found comes within reach of the opening of the window's edges
+    inside the image, where it could continue: the result is the whole
+    image's either way.
+    """
+    window = grown_box(depth_mask, 4 * halo_px + FLAT_WINDOW_PX)
+    options = (colour_distance, lightness_weight, shadow_lightness, halo_px)
+    found = _unlike_in(image[window], depth_mask[window], halo[window], table[window], *options)
+    if _reaches_inner_edge(found, window, depth_mask.shape, 2 * EVIDENCE_OPEN_PX + 1):
+        return _unlike_in(image, depth_mask, halo, table, *options)
+    unlike = np.zeros(depth_mask.shape, dtype=bool)
+    unlike[window] = found
+    return unlike
+
+
+def _unlike_in(image, depth_mask, halo, table, colour_distance, lightness_weight, shadow_lightness, halo_px):
+    """:func:`_unlike_table` on the given arrays (the whole image or a window holding the table ring)."""
+    lab = cv2.cvtColor(np.ascontiguousarray(image), cv2.COLOR_RGB2LAB)
+    ring = dilate(depth_mask, 4 * halo_px) & ~halo & table
+    if not ring.any():
+        return np.zeros(depth_mask.shape, dtype=bool)
+    # Squared distance per channel by table look-up, summed: 8-bit values less a median (a multiple
+    # of 0.5) square to multiples of 0.25 below 2^16, which float32 and their sum hold exactly.
+    table_lab = np.median(lab[ring], axis=0)
+    squares = (np.arange(256.0)[:, None] - table_lab) ** 2
+    per_channel = cv2.LUT(lab, squares.astype(np.float32)[None])
+    unlike = cv2.transform(per_channel, np.array([[lightness_weight ** 2, 1.0, 1.0]])) > np.float64(colour_distance) ** 2
+    unlike |= lab[..., 0] < shadow_lightness * table_lab[0]
+    return connected_to(opening(unlike, EVIDENCE_OPEN_PX) | depth_mask, depth_mask) & ~depth_mask
+
+
+def _reaches_inner_edge(region, window, shape, width) -> bool:
+    """Whether ``region`` (the ``window`` of an image of ``shape``) has a pixel within ``width`` of a window edge
+    that is not the image's edge."""
+    rows, cols = window
+    return bool((rows.start > 0 and region[:width].any()) or (rows.stop < shape[0] and region[-width:].any())
+                or (cols.start > 0 and region[:, :width].any()) or (cols.stop < shape[1] and region[:, -width:].any()))
+
+
+def colour_offset(rgb, depth, mask, *, max_offset_px: int = MAX_COLOUR_OFFSET_PX) -> tuple[int, int]:
+    """The colour-depth misregistration near the object: the shift (dx, dy) that carries colour onto depth.
+
+    Depth pixel (u + dx, v + dy) sees what colour pixel (u, v) sees. Of the
+    integer shifts up to ``max_offset_px`` each way, the one at which the two
+    images' edges agree best around the object: the normalised
+    cross-correlation (OpenCV's ``TM_CCOEFF_NORMED``) of the colour image's
+    gradient magnitude (Sobel, summed over the CIELAB channels) with the depth
+    image's, over ``mask``'s bounding box grown by ``REGISTRATION_MARGIN_PX``.
+    A window without edges in either image gives (0, 0).
+
+    A "registered" PrimeSense pair is not registered to the pixel (module
+    docstring); the object's edges are used because the registration error
+    of such sensors changes with depth.
+
+    Parameters
+    ----------
+    rgb : (H, W, 3) uint8
+        Colour image in RGB order, or (H, W) uint8 grayscale.
+    depth : (H, W) or (H, W, 1) float
+        Depth in meters, of the same size; invalid readings are ignored.
+    mask : (H, W) bool
+        The object as depth sees it.
+    max_offset_px : int
+        Largest shift searched, pixels.
+
+    Returns
+    -------
+    (int, int)
+        (dx, dy), pixels.
+
+    Examples
+    --------
+    >>> depth = np.full((120, 160), 0.7); depth[40:80, 50:110] = 0.65
+    >>> rgb = np.full((120, 160, 3), 200, np.uint8); rgb[43:83, 48:108] = 30
+    >>> colour_offset(rgb, depth, depth < 0.68)
+    (2, -3)
+    """
+    image = as_rgb(rgb)
+    d = as_depth(depth)
+    validation.same_size(image.shape, d.shape, "rgb image", "depth image", error=PerceptionError)
+    validation.same_size(np.shape(mask), d.shape, "mask", "depth image", error=PerceptionError)
+    r = validation.integer("max_offset_px", max_offset_px, 0, error=PerceptionError)
+    m = np.asarray(mask, dtype=bool)
+    if not m.any():
+        raise PerceptionError("colour_offset needs a mask with at least one object pixel")
+    rows, cols = grown_box(m, REGISTRATION_MARGIN_PX)
+    height, width = d.shape
+    top, bottom = max(rows.start, r), min(rows.stop, height - r)
+    left, right = max(cols.start, r), min(cols.stop, width - r)
+    if r == 0 or bottom - top < 3 or right - left < 3:
+        return 0, 0
+    window = np.s_[top - r: bottom + r, left - r: right + r]
+    lab = cv2.cvtColor(image[window], cv2.COLOR_RGB2LAB).astype(np.float32)
+    colour_edges = sum(_gradient_magnitude(lab[..., k]) for k in range(3))[r:-r, r:-r]
+    near = d[window].astype(np.float32)
+    valid = np.isfinite(near) & (near > 0)
+    if not valid.any():
+        return 0, 0
+    near[~valid] = np.median(near[valid])
+    depth_edges = _gradient_magnitude(near)
+    if colour_edges.std() == 0 or depth_edges.std() == 0:
+        return 0, 0
+    score = cv2.matchTemplate(depth_edges, colour_edges, cv2.TM_CCOEFF_NORMED)
+    dy, dx = np.unravel_index(np.argmax(score), score.shape)
+    return int(dx) - r, int(dy) - r
+
+
+def register_colour(rgb, offset) -> np.ndarray:
+    """(H, W, 3) uint8: the colour image shifted by ``offset`` = (dx, dy) onto the depth image (:func:`colour_offset`).
+
+    The strip uncovered at the edge repeats the edge pixels.
+    """
+    image = as_rgb(rgb)
+    dx, dy = offset
+    shift = np.array([[1.0, 0.0, dx], [0.0, 1.0, dy]])
+    return cv2.warpAffine(image, shift, image.shape[1::-1], flags=cv2.INTER_NEAREST, borderMode=cv2.BORDER_REPLICATE)
+
+
+def _gradient_magnitude(image):
+    return cv2.magnitude(cv2.Sobel(image, cv2.CV_32F, 1, 0), cv2.Sobel(image, cv2.CV_32F, 0, 1))

@@ -1,0 +1,177 @@
+"""Depth segmentation: the region standing above the table, or its footprint on the table (a tilted camera).
+
+Depth does not see shadows, printed texture or the table's edge; it misses
+what is lower than ``min_height`` (a flat part), which
+:func:`~contourgrasp.perception.colour.add_flat_parts` finds by colour.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import cv2
+import numpy as np
+
+from .. import validation
+from ..errors import PerceptionError
+from ..tolerances import MAX_HOLE_PX, MIN_AREA_PX, MIN_HEIGHT, SENSOR_RANGE, TILT_PLANE_THRESHOLD
+from ._pixels import disc, in_image
+from .camera import Intrinsics, as_depth, check_intrinsics, fill_depth_holes, valid_depth
+from .region import Segmentation, make_segmentation, pick_object
+from .table import Plane, fit_table_plane, footprint_pixels, heights
+
+
+def segment_depth(
+    depth,
+    intrinsics: Intrinsics,
+    *,
+    min_height: float = MIN_HEIGHT,
+    plane: Plane | None = None,
+    fill_holes: bool = True,
+    max_hole_px: int = MAX_HOLE_PX,
+    min_area_px: int = MIN_AREA_PX,
+    depth_range=SENSOR_RANGE,
+    footprint: bool | None = None,
+    seed: int = 0,
+) -> Segmentation:
+    """The region standing above the table, or its footprint on the table.
+
+    Small holes are filled (:func:`fill_depth_holes`, when ``fill_holes``);
+    the table is fitted (:func:`fit_table_plane`) unless ``plane`` is given;
+    pixels with a valid reading more than ``min_height`` above it are
+    candidates, opened with a 3 x 3 element to drop speckle; the object is the
+    largest 8-connected candidate region that touches neither the image border
+    nor missing readings connected to it (the sensor's dead band), with its
+    holes filled. With ``footprint`` that region is then moved onto the table
+    (:func:`object_footprint`) and the result is marked ``on_table``.
+
+    By default (``footprint=None``) the footprint is taken when the camera is
+    tilted more than ``TILT_PLANE_THRESHOLD`` (2 deg) from the table's normal,
+    where the region seen is displaced from where the object stands. A
+    top-down camera keeps the thesis's reading, the region seen, which eq
+    3.1-3.2 then measure at the table's depth (the outline overstated by
+    height / depth); the footprint would measure it exactly, but it lowered
+    the success rates of the simulated top-down bench (README, "Perception"),
+    so it is an option there (``plan_grasp(footprint=True)``).
+
+    An object, or a part of one, lower than ``min_height`` is invisible to this
+    method: the flat metal head of the shared can opener (frame 6) is, and only
+    its raised grip is found (:func:`add_flat_parts` finds the rest by colour).
+
+    Parameters
+    ----------
+    depth : (H, W) or (H, W, 1) float
+        Depth in meters.
+    intrinsics : Intrinsics
+        Of the depth image.
+    min_height : float
+        Height above the table (m) from which a pixel is object.
+    plane : Plane, optional
+        The table, if already known.
+    fill_holes : bool
+        Fill holes of at most ``max_hole_px`` pixels first.
+    max_hole_px : int
+        See :func:`fill_depth_holes`.
+    min_area_px : int
+        Smallest object, pixels.
+    depth_range : (float, float)
+        Valid depth readings, m.
+    footprint : bool or None
+        Return the object's footprint rather than the pixels that see it;
+        None: when the camera is tilted (above).
+    seed : int
+        RANSAC seed.
+
+    Raises
+    ------
+    SegmentationError
+        No table plane, nothing above it, the object touches the border, or it is tiny.
+    """
+    seen, d = seen_above_table(depth, intrinsics, min_height=min_height, plane=plane, fill_holes=fill_holes,
+                                max_hole_px=max_hole_px, min_area_px=min_area_px, depth_range=depth_range, seed=seed)
+    return with_footprint(seen, d, intrinsics, footprint, min_area_px)
+
+
+def seen_above_table(depth, intrinsics, *, min_height, plane, fill_holes, max_hole_px, min_area_px, depth_range, seed):
+    """:func:`segment_depth` without the footprint: the region seen above the table, and the hole-filled depth."""
+    d = as_depth(depth)
+    check_intrinsics(intrinsics).check_shape(d.shape, "depth image")
+    if plane is not None and not isinstance(plane, Plane):
+        raise PerceptionError(f"plane must be a contourgrasp.perception.Plane, got {type(plane).__name__}")
+    validation.flag("fill_holes", fill_holes, error=PerceptionError)
+    seed = validation.integer("seed", seed, 0, error=PerceptionError)
+    min_height = validation.positive("min_height", min_height, error=PerceptionError)
+    min_area_px = validation.integer("min_area_px", min_area_px, 1, error=PerceptionError)
+    filled = 0
+    if fill_holes:
+        d, filled = fill_depth_holes(d, max_hole_px=max_hole_px)
+    if plane is None:
+        plane = fit_table_plane(d, intrinsics, depth_range=depth_range, seed=seed)
+    valid = valid_depth(d, depth_range)
+    with np.errstate(invalid="ignore"):
+        above = valid & (heights(d, intrinsics, plane) > min_height)
+    above = cv2.morphologyEx(above.astype(np.uint8), cv2.MORPH_OPEN, np.ones((3, 3), np.uint8)) > 0
+    mask, notes = pick_object(above, _border_connected(~valid), min_area_px,
+                               f"more than {min_height * 1000:.0f} mm above the table")
+    return make_segmentation("depth", mask, notes, plane=plane, filled_px=filled), d
+
+
+def with_footprint(seg, depth, intrinsics, footprint, min_area_px) -> Segmentation:
+    """``seg`` moved onto the table (:func:`object_footprint`) when ``footprint``, or when None and the camera is tilted."""
+    if footprint is None:
+        footprint = seg.plane.tilt > TILT_PLANE_THRESHOLD
+    elif not isinstance(footprint, (bool, np.bool_)):
+        raise PerceptionError(f"footprint must be True, False or None, got {footprint!r}")
+    if not footprint:
+        return seg
+    moved = object_footprint(seg.mask, depth, intrinsics, seg.plane)
+    mask, notes = pick_object(moved, np.zeros_like(moved), min_area_px, "in the object's footprint on the table")
+    result = make_segmentation(seg.method, mask, notes, plane=seg.plane, filled_px=seg.filled_px, on_table=True,
+                           colour_offset_px=seg.colour_offset_px)
+    return replace(result, warnings=(*seg.warnings, *result.warnings))
+
+
+def object_footprint(mask, depth, intrinsics: Intrinsics, plane: Plane) -> np.ndarray:
+    """Where the table holds what ``mask`` sees: the object's outline as a top-down view measures it.
+
+    Every valid pixel of ``mask`` is back-projected, moved along the table's
+    normal onto the table and projected back into the image
+    (the rounded pixels they fall on); the hit pixels are closed with a 5 x 5 disc,
+    which joins the samples that the object's steep sides spread apart (holes
+    are left to the caller, e.g. :func:`segment_depth`'s object picking).
+
+    A camera that is not top-down sees a tall object's top displaced from its
+    base, by height x sin(tilt) / depth x f pixels (8 px for 5 cm at 0.7 m,
+    12.7 deg, f = 525 px), and sees its near side as well; a top-down camera
+    sees the top enlarged by depth / (depth - height). The footprint undoes
+    both: it is where the object stands, the outline a hand approaching along
+    the table's normal closes on, and on the shared PrimeSense frames it is
+    nearer to the hand-made masks than the region seen above the table
+    (``benchmarks/segmentation.py``, README "Perception").
+
+    Parameters
+    ----------
+    mask : (H, W) bool
+        Pixels that see the object.
+    depth : (H, W) float
+        Depth in meters.
+    intrinsics : Intrinsics
+        Of the depth image.
+    plane : Plane
+        The table.
+
+    Returns
+    -------
+    (H, W) bool
+    """
+    rows, cols = np.nonzero(mask & valid_depth(depth))
+    seen, u, v = in_image(footprint_pixels(depth, intrinsics, plane, rows, cols), mask.shape)
+    hit = np.zeros(mask.shape, dtype=np.uint8)
+    hit[v[seen], u[seen]] = 1
+    return cv2.morphologyEx(hit, cv2.MORPH_CLOSE, disc(2)) > 0
+
+
+def _border_connected(missing) -> np.ndarray:
+    """(H, W) bool: the pixels of ``missing`` connected (8-neighbour) to the image border."""
+    _, labels = cv2.connectedComponents(np.pad(missing, 1, constant_values=True).astype(np.uint8), connectivity=8)
+    return (labels == labels[0, 0])[1:-1, 1:-1]

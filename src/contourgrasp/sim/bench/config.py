@@ -1,0 +1,196 @@
+"""What a bench runs: objects x trials x planners, the scene, the object sets, and the thesis's objects and labels."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from ...errors import SimulationError
+from ...hand import Hand
+from ...io.hand_file import load_hand
+from ...validation import integer
+from ..hand_model import build_hand
+from ..objects import THESIS_OBJECTS, ObjectSpec, object_spec
+from ..planners import BASELINES, make_planner, synthesis_planner
+from ..scene import Camera, Workspace
+from ..trial import DROPPED, NO_PLAN, PUSHED, SLIPPED, STRUCK, TrialRecord, run_trial
+
+#: Success rates of Table 4.4 (real arm and qbHand, 10 trials per object).
+THESIS_SUCCESS = {"can": 0.8, "case": 0.4, "bottle": 0.7, "stone1": 0.2, "stone2": 0.6}
+#: Column headings of Table 4.4 for the simulated objects.
+LABELS = {"can": "can", "case": "glasses case", "bottle": "bottle", "stone1": "stone 1", "stone2": "stone 2"}
+#: Short failure causes for the trial tables.
+SHORT_CAUSES = {NO_PLAN: "no plan", STRUCK: "struck", PUSHED: "pushed", SLIPPED: "slipped", DROPPED: "dropped"}
+
+
+@dataclass(frozen=True)
+class Bench:
+    """What to run: objects x trials x planners, and the scene.
+
+    Attributes
+    ----------
+    objects : tuple of ObjectSpec
+        Distinct names; they head the table's columns.
+    planners : tuple of str
+        Planner names (:func:`~contourgrasp.sim.planners.make_planner`).
+    trials : int
+        Per object and planner.
+    seed : int
+        Trial ``t`` uses seed ``seed + t``.
+    hand : Hand
+        Simulated, and planned for.
+    noise : bool
+        Depth noise in the planner's picture.
+    camera, workspace
+        Scene parameters (:mod:`contourgrasp.sim.scene`).
+    splits : tuple of (str, tuple of str)
+        Named object sets (``ycb-train``, ``ycb-test``, ...) and the names of
+        their objects, for the per-split report; empty: no split, the thesis's
+        report.
+
+    Raises
+    ------
+    SimulationError
+        No object, repeated object or planner names, an unknown planner, fewer
+        than one trial, a negative seed, a split naming an object the bench does
+        not run, or a hand the simulation cannot build.
+    """
+
+    objects: tuple[ObjectSpec, ...]
+    planners: tuple[str, ...] = ("paper", "default", *BASELINES)
+    trials: int = 20
+    seed: int = 0
+    hand: Hand = field(default_factory=lambda: load_hand("five-finger-linear"))
+    noise: bool = True
+    camera: Camera = field(default_factory=Camera)
+    workspace: Workspace = field(default_factory=Workspace)
+    splits: tuple[tuple[str, tuple[str, ...]], ...] = ()
+
+    def __post_init__(self):
+        object.__setattr__(self, "objects", tuple(self.objects))
+        object.__setattr__(self, "planners", tuple(self.planners))
+        object.__setattr__(self, "splits", tuple((str(s), tuple(members)) for s, members in self.splits))
+        names = [o.name for o in self.objects]
+        if not names:
+            raise SimulationError("no object to grasp")
+        if len(set(names)) != len(names):
+            raise SimulationError(f"object names must differ, got {', '.join(names)}")
+        if not self.planners or len(set(self.planners)) != len(self.planners):
+            raise SimulationError(f"planners must be distinct names, got {', '.join(self.planners) or 'none'}")
+        for planner in self.planners:
+            synthesis_planner(planner)  # refuses an unknown name before any trial runs
+        object.__setattr__(self, "trials", integer("trials", self.trials, 1, error=SimulationError))
+        object.__setattr__(self, "seed", integer("seed", self.seed, 0, error=SimulationError))
+        for split, members in self.splits:
+            missing = [m for m in members if m not in names]
+            if missing or not members:
+                raise SimulationError(f"split {split!r} names {missing[0] if missing else 'no object'}, "
+                                      f"which the bench does not run")
+        build_hand(self.hand)  # refuses a hand the simulation cannot build before any trial runs
+
+    @property
+    def size(self) -> int:
+        """Number of trials."""
+        return len(self.objects) * self.trials * len(self.planners)
+
+    def object(self, name: str) -> ObjectSpec:
+        """The object called ``name``."""
+        return next(o for o in self.objects if o.name == name)
+
+    def split_of(self, name: str) -> str | None:
+        """The first split the object called ``name`` belongs to (None: none)."""
+        return next((split for split, members in self.splits if name in members), None)
+
+    def tasks(self) -> list[tuple[str, int, int]]:
+        """Every trial as (planner, object index, trial), object by object (so objects finish one after another)."""
+        return [(planner, index, trial) for index in range(len(self.objects)) for planner in self.planners
+                for trial in range(self.trials)]
+
+    def run(self, planner: str, obj: ObjectSpec, trial: int, *, plan=None, observe=None) -> TrialRecord:
+        """Run one trial; ``plan`` replaces the named planner's callable (same answers), ``observe`` see run_trial."""
+        seed = self.seed + trial
+        return run_trial(obj, seed=seed, planner=plan or make_planner(planner, self.hand, seed=seed), hand=self.hand,
+                         noise=self.noise, camera=self.camera, workspace=self.workspace, observe=observe)
+
+
+@dataclass(frozen=True)
+class BenchTrial:
+    """One trial of the bench: which planner, which trial (0-based), and its record."""
+
+    planner: str
+    trial: int
+    record: TrialRecord
+
+
+# Object sets of --objects. The YCB sets (issue 15) come from contourgrasp.sim.ycb once it is merged:
+# its OBJECT_SETS, object_names and load_object then replace the three thesis-only definitions below.
+#: Named object sets ``--objects`` takes; a set named there becomes a split of the report.
+OBJECT_SETS = {"thesis": tuple(THESIS_SUCCESS)}
+
+
+def object_names(objects) -> tuple[str, ...]:
+    """The object names ``objects`` (comma-separated or listed) stands for, sets expanded, in order, each once.
+
+    Raises
+    ------
+    SimulationError
+        An unknown name.
+    """
+    tokens = [t.strip() for t in objects.split(",")] if isinstance(objects, str) else [str(t) for t in objects]
+    names = tuple(dict.fromkeys(n for t in filter(None, tokens) for n in OBJECT_SETS.get(t, (t,))))
+    _known(names)
+    return names
+
+
+def load_object(name: str) -> ObjectSpec:
+    """The :class:`ObjectSpec` of a name of :func:`object_names`."""
+    return object_spec(name)
+
+
+def resolve_objects(objects) -> tuple[tuple[ObjectSpec, ...], tuple[tuple[str, tuple[str, ...]], ...]]:
+    """The objects of ``--objects`` and the splits it names: ``(objects, splits)`` for :class:`Bench`.
+
+    Every name is checked before any object is loaded. A set name of
+    :data:`OBJECT_SETS` among ``objects`` becomes a split (its members'
+    object names); plain object names belong to none.
+
+    Raises
+    ------
+    SimulationError
+        An unknown name.
+
+    Examples
+    --------
+    >>> objects, splits = resolve_objects("thesis")
+    >>> [o.name for o in objects] == list(splits[0][1])
+    True
+    """
+    tokens = [t.strip() for t in objects.split(",")] if isinstance(objects, str) else [str(t) for t in objects]
+    specs = tuple(load_object(n) for n in object_names(tokens))
+    names = [o.name for o in specs]
+    splits = tuple((t, tuple(n for n in names if n in OBJECT_SETS[t])) for t in dict.fromkeys(tokens)
+                   if t in OBJECT_SETS)
+    return specs, splits
+
+
+def thesis_objects(names) -> tuple[ObjectSpec, ...]:
+    """The objects of :data:`~contourgrasp.sim.objects.THESIS_OBJECTS` called ``names``.
+
+    Raises
+    ------
+    SimulationError
+        An unknown name.
+    """
+    _known(names)
+    return tuple(object_spec(n) for n in names)
+
+
+def _known(names) -> None:
+    unknown = [n for n in names if n not in THESIS_OBJECTS]
+    if unknown:
+        raise SimulationError(f"unknown object {unknown[0]!r}: choose from {', '.join(THESIS_OBJECTS)} "
+                              f"or pass --mesh FILE")
+
+
+def label(name: str) -> str:
+    """Column heading of an object."""
+    return LABELS.get(name, name)

@@ -1,0 +1,326 @@
+"""The bench's outputs: Markdown tables, the trial records as JSON, and writing them all into one folder.
+
+Outputs (:func:`write_outputs`, all written atomically into one folder):
+
+* ``table.md`` -- success rates of every planner beside the thesis's, then per
+  planner a table laid out like Table 4.4 (trial rows, object columns, success
+  rate row, the thesis's rates) and its causes of failure;
+* ``trials.json`` -- one record per trial (:func:`trial_to_dict`);
+* ``success.png`` -- success rate per object and planner, the thesis's beside;
+* ``trials.png`` -- per planner its first success and first failure with a plan:
+  the camera's picture with the plan drawn on it, and the hand at the end of the
+  hold seen from the side (:func:`~contourgrasp.sim.bench.figures.trials_figure`).
+
+A bench whose objects come from named sets (:attr:`Bench.splits`, e.g.
+``ycb-train`` and ``ycb-test``) is reported per split instead: ``table.md``
+holds a per-split summary (rate, 95 % Wilson interval and failure causes per
+planner) and a per-object table sorted by ``default``'s rate; ``success.png``
+is a bar chart per object and split
+(:func:`~contourgrasp.sim.bench.figures.objects_figure`); ``failures.png`` a
+mosaic of failed trials (:func:`~contourgrasp.sim.bench.figures.failures_figure`).
+"""
+
+from __future__ import annotations
+
+import math
+import statistics
+from dataclasses import asdict
+from pathlib import Path
+
+from ...io.plan_file import atomic_outputs, write_json
+from ..planners import BASELINES, ablation_planners, synthesis_planner
+from ..trial import FAILURE_CAUSES, TrialRecord
+from .config import SHORT_CAUSES, Bench, BenchTrial, label
+from .run import picked_trials, snapshot
+from .stats import records, sort_planner, success_rates, thesis_rates, wilson_interval
+
+#: Output file names.
+TABLE, TRIALS, CHART, PICTURE, FAILURES = "table.md", "trials.json", "success.png", "trials.png", "failures.png"
+#: Failed trials in the mosaic of a bench with splits, at most.
+MOSAIC_TILES = 12
+
+
+def trial_to_dict(result: BenchTrial) -> dict:
+    """The JSON record of a trial: planner, trial, then every field of its :class:`TrialRecord` (SI units)."""
+    record = asdict(result.record)
+    pose = record.pop("pose")
+    return {
+        "object": record.pop("object"),
+        "planner": result.planner,
+        "trial": result.trial,
+        **record,
+        "pose": None if pose is None else dict(zip(("x", "y", "yaw"), pose)),
+    }
+
+
+def trial_from_dict(data: dict) -> BenchTrial:
+    """The trial of a :func:`trial_to_dict` record (read back from JSON): equal to the one written."""
+    fields = dict(data)
+    planner, trial, pose = fields.pop("planner"), fields.pop("trial"), fields.pop("pose")
+    fields["fingers_in_contact"] = tuple(fields["fingers_in_contact"])
+    fields["first_contact"] = tuple((finger, t) for finger, t in fields["first_contact"])
+    fields["pose"] = None if pose is None else (pose["x"], pose["y"], pose["yaw"])
+    return BenchTrial(planner, trial, TrialRecord(**fields))
+
+
+def write_outputs(bench: Bench, results, out, *, wall_time: float) -> list[Path]:
+    """Write table.md, trials.json, success.png and trials.png (failures.png too with splits) into ``out``.
+
+    ``out`` is created if missing; returns the paths written.
+    """
+    from .figures import failures_figure, objects_figure, success_figure, trials_figure
+
+    snapshots = [snapshot(bench, r) for r in picked_trials(results)]
+    failed = [snapshot(bench, r) for r in picked_failures(bench, results)] if bench.splits else []
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    names = (TABLE, TRIALS, CHART, PICTURE, *((FAILURES,) if bench.splits else ()))
+    paths = [out / name for name in names]
+    with atomic_outputs(*paths) as (table, trials, chart, picture, *mosaic):
+        Path(table).write_text(markdown(bench, results, wall_time=wall_time), encoding="utf-8")
+        write_json([trial_to_dict(r) for r in results], trials)
+        chart_figure = objects_figure(bench, results) if bench.splits else success_figure(bench, results)
+        chart_figure.savefig(chart, dpi=110, format="png")
+        trials_figure(bench, snapshots).savefig(picture, dpi=90, format="png")
+        for path in mosaic:
+            failures_figure(bench, failed).savefig(path, dpi=80, format="png")
+    return paths
+
+
+def picked_failures(bench: Bench, results, limit: int = MOSAIC_TILES) -> list[BenchTrial]:
+    """Failed trials with a plan, one per planner and object: :func:`sort_planner`'s first, lowest rates first.
+
+    The other planners' failures fill the rest, up to ``limit``.
+    """
+    names = [o.name for o in bench.objects]
+    picked = []
+    for planner in dict.fromkeys([sort_planner(bench), *bench.planners]):
+        rates = success_rates(results, planner, names)
+        for name in sorted(names, key=lambda o: (rates[o], names.index(o))):
+            picked += [r for r in results if r.planner == planner and r.record.object == name
+                       and not r.record.success and r.record.pose is not None][:1]
+    return picked[:limit]
+
+
+def _percent(rate: float | None) -> str:
+    return "—" if rate is None else f"{100 * rate:.0f} %"
+
+
+def _row(cells) -> str:
+    return "| " + " | ".join(str(c) for c in cells) + " |"
+
+
+def _header(first: str, columns, *, left: int = 0) -> list[str]:
+    """A table's heading: ``first`` and the first ``left`` columns left-aligned, the others right-aligned."""
+    return [_row([first, *columns]), _row(["---", *["---"] * left, *["---:"] * (len(columns) - left)])]
+
+
+def markdown(bench: Bench, results, *, wall_time: float) -> str:
+    """The whole of table.md (:func:`split_markdown` for a bench with splits)."""
+    if bench.splits:
+        return split_markdown(bench, results, wall_time=wall_time)
+    lines = [
+        "# contourgrasp bench: the grasping experiment of thesis 4.2.4 (Table 4.4), simulated",
+        "",
+        _setup_text(bench, len(results), wall_time),
+        "",
+        *planner_notes(bench, results),
+        "",
+        "## Success rates",
+        "",
+        "Each cell: success rate and its 95 % Wilson interval.",
+        "",
+        *rates_table(bench, results),
+    ]
+    ablation = ablation_table(bench, results)
+    if ablation:
+        lines += ["", "## Ablation: paper to default", "",
+                  "Each step adds default's value of one group of options to the step above (overall success, its "
+                  "95 % Wilson interval, and failures by cause).", "", *ablation]
+    for planner in bench.planners:
+        lines += ["", f"## {planner}", "", *trial_table(bench, results, planner), "",
+                  f"Causes of failure ({planner}):", "", *cause_table(bench, results, planner)]
+    lines += ["", "✓ success; ✗ failure and its cause: " + ", ".join(f"{v} = {k}" for k, v in SHORT_CAUSES.items())
+              + ". Success: lifted at least 0.10 m and moved less than 0.02 m in the hand during the 2 s hold."]
+    return "\n".join(lines) + "\n"
+
+
+def _setup_text(bench: Bench, n_trials: int, wall_time: float) -> str:
+    return (f"{len(bench.objects)} object(s) x {bench.trials} trial(s) x {len(bench.planners)} planner(s) = "
+            f"{n_trials} trials in {wall_time:.0f} s wall time. Hand `{bench.hand.name}` (one tendon, the thesis's "
+            f"finger timing); depth noise {'on' if bench.noise else 'off'}; trial t uses seed {bench.seed} + t, the "
+            f"same scene for every planner. The thesis's rates are from a real arm and hand, ours from the "
+            f"simulation; with {bench.trials} trial(s) per object a rate's standard error is up to "
+            f"{50 / math.sqrt(bench.trials):.0f} points.")
+
+
+def _rate_cell(own) -> str:
+    wins = sum(r.success for r in own)
+    low, high = wilson_interval(wins, len(own))
+    return f"{100 * wins / len(own):.0f} % ({100 * low:.0f}–{100 * high:.0f})"
+
+
+def rates_table(bench: Bench, results) -> list[str]:
+    """Success rate and its 95 % Wilson interval per planner (rows) and object (columns), Table 4.4's first."""
+    objects = [o.name for o in bench.objects]
+    lines = [*_header("planner", [label(o) for o in objects] + ["all"]),
+             _row(["thesis, real robot (Table 4.4)", *map(_percent, thesis_rates(objects).values())])]
+    for planner in bench.planners:
+        name = planner + (" (baseline)" if planner in BASELINES else "")
+        cells = [_rate_cell(records(results, planner, o)) for o in objects] + [_rate_cell(records(results, planner))]
+        lines.append(_row([name, *cells]))
+    return lines
+
+
+def ablation_table(bench: Bench, results) -> list[str]:
+    """The ablation from ``paper`` to ``default`` (rows in step order, those the bench ran): rates and causes."""
+    steps = [p.name for p in ablation_planners()]
+    names = {name: name for name in steps[:-1]} | {steps[-1]: "default"}
+    rows = [(step, planner) for step, planner in names.items() if planner in bench.planners]
+    lines = _header("step", ["all", *(SHORT_CAUSES[c] for c in FAILURE_CAUSES)])
+    for step, planner in rows:
+        own = records(results, planner)
+        shown = step if planner == step else f"{step} = `default`"
+        lines.append(_row([shown, _rate_cell(own), *(sum(r.cause == c for r in own) for c in FAILURE_CAUSES)]))
+    return lines if rows else []
+
+
+def planner_notes(bench: Bench, results) -> list[str]:
+    """One bullet per planner: what it is, its settings, its median planning time."""
+    notes = []
+    for planner in bench.planners:
+        times = [r.plan_time for r in records(results, planner)]
+        timing = f" Median planning time {statistics.median(times):.2f} s."
+        settings = synthesis_planner(planner)
+        if settings is None:
+            notes.append(f"- `{planner}` (baseline): {BASELINES[planner]}.{timing}")
+            continue
+        text = ", ".join(f"{k}={_option(k, v)}" for k, v in settings.options) or "the library's defaults"
+        notes.append(f"- `{planner}`: `plan_grasp` with {text}.{timing}")
+    return notes
+
+
+def _option(name: str, value) -> str:
+    if name == "yaw_step":
+        return f"{math.degrees(value):g}°"
+    return f"{value}"
+
+
+def trial_table(bench: Bench, results, planner: str) -> list[str]:
+    """Table 4.4's layout for one planner: a row per trial, a column per object, rates last."""
+    objects = [o.name for o in bench.objects]
+    own = {(r.record.object, r.trial): r.record for r in results if r.planner == planner}
+    lines = _header("trial", [label(o) for o in objects])
+    for trial in range(bench.trials):
+        cells = ["✓" if own[o, trial].success else f"✗ {SHORT_CAUSES[own[o, trial].cause]}" for o in objects]
+        lines.append(_row([trial + 1, *cells]))
+    rates = success_rates(results, planner, objects)
+    thesis = thesis_rates(objects)
+    lines.append(_row(["**success rate**", *(f"**{_percent(rates[o])}**" for o in objects)]))
+    lines.append(_row(["thesis (Table 4.4)", *(_percent(thesis[o]) for o in objects)]))
+    return lines
+
+
+def cause_table(bench: Bench, results, planner: str) -> list[str]:
+    """Failures of one planner by cause (rows) and object (columns)."""
+    objects = [o.name for o in bench.objects]
+    own = records(results, planner)
+    lines = _header("cause", [label(o) for o in objects] + ["all"])
+    for cause in FAILURE_CAUSES:
+        counts = [sum(r.cause == cause for r in own if r.object == o) for o in objects]
+        lines.append(_row([cause, *counts, sum(counts)]))
+    return lines
+
+
+def split_markdown(bench: Bench, results, *, wall_time: float) -> str:
+    """table.md of a bench with splits: setup, planners, per split, per object, the ablation."""
+    splits = ", ".join(f"{name} ({len(members)} objects)" for name, members in bench.splits)
+    lines = [
+        f"# contourgrasp bench: {splits}, simulated",
+        "",
+        _split_setup_text(bench, len(results), wall_time),
+        "",
+        *planner_notes(bench, results),
+        "",
+        "## Per split",
+        "",
+        "Each cell: success rate, its 95 % Wilson interval, and successes / trials.",
+        "",
+        *split_table(bench, results),
+        "",
+        "Failures by cause:",
+        "",
+        *split_cause_table(bench, results),
+        "",
+        "## Per object",
+        "",
+        f"Sorted by `{sort_planner(bench)}`'s rate, highest first; each cell: success rate and its 95 % Wilson "
+        f"interval; last, `{sort_planner(bench)}`'s failures by cause.",
+        "",
+        *object_table(bench, results),
+    ]
+    ablation = ablation_table(bench, results)
+    if len(ablation) > 3:  # more than one step ran
+        lines += ["", "## Ablation: paper to default", "", *ablation]
+    lines += ["", "Success: lifted at least 0.10 m and moved less than 0.02 m in the hand during the 2 s hold. "
+              "Causes: " + ", ".join(f"{v} = {k}" for k, v in SHORT_CAUSES.items()) + "."]
+    return "\n".join(lines) + "\n"
+
+
+def _split_setup_text(bench: Bench, n_trials: int, wall_time: float) -> str:
+    return (f"{len(bench.objects)} object(s) x {bench.trials} trial(s) x {len(bench.planners)} planner(s) = "
+            f"{n_trials} trials in {wall_time:.0f} s wall time. Hand `{bench.hand.name}` (one tendon, the thesis's "
+            f"finger timing); depth noise {'on' if bench.noise else 'off'}; trial t uses seed {bench.seed} + t, the "
+            f"same scene for every planner. With {bench.trials} trial(s) per object an object's rate has a standard "
+            f"error of up to {50 / math.sqrt(bench.trials):.0f} points; a split's intervals are below.")
+
+
+def _groups(bench: Bench) -> list[tuple[str, tuple[str, ...]]]:
+    """The splits, then objects in none of them ("other"), then every object ("all")."""
+    named = {m for _, members in bench.splits for m in members}
+    other = tuple(o.name for o in bench.objects if o.name not in named)
+    groups = [*bench.splits, *((("other", other),) if other else ())]
+    everything = tuple(o.name for o in bench.objects)
+    return groups if len(groups) == 1 and set(groups[0][1]) == set(everything) else [*groups, ("all", everything)]
+
+
+def _of(results, planner: str, members) -> list:
+    return [r for r in records(results, planner) if r.object in members]
+
+
+def split_table(bench: Bench, results) -> list[str]:
+    """Success rate, its 95 % Wilson interval and the counts per planner (rows) and split (columns)."""
+    groups = _groups(bench)
+    lines = _header("planner", [name for name, _ in groups])
+    for planner in bench.planners:
+        name = planner + (" (baseline)" if planner in BASELINES else "")
+        cells = []
+        for _, members in groups:
+            own = _of(results, planner, members)
+            cells.append(f"{_rate_cell(own)} {sum(r.success for r in own)}/{len(own)}")
+        lines.append(_row([name, *cells]))
+    return lines
+
+
+def split_cause_table(bench: Bench, results) -> list[str]:
+    """Failures per planner and split (rows) by cause (columns)."""
+    lines = _header("planner", ["split", *(SHORT_CAUSES[c] for c in FAILURE_CAUSES)], left=1)
+    for planner in bench.planners:
+        for split, members in _groups(bench):
+            own = _of(results, planner, members)
+            lines.append(_row([planner, split, *(sum(r.cause == c for r in own) for c in FAILURE_CAUSES)]))
+    return lines
+
+
+def object_table(bench: Bench, results) -> list[str]:
+    """A row per object, sorted by :func:`sort_planner`'s rate (highest first): split, every planner's rate, causes."""
+    planner = sort_planner(bench)
+    names = [o.name for o in bench.objects]
+    rates = success_rates(results, planner, names)
+    lines = _header("object", ["split", *bench.planners, f"{planner}'s failures"], left=1)
+    for name in sorted(names, key=lambda o: (-rates[o], names.index(o))):
+        causes = [r.cause for r in records(results, planner, name) if r.cause is not None]
+        failures = ", ".join(f"{SHORT_CAUSES[c]} {causes.count(c)}" for c in FAILURE_CAUSES if c in causes)
+        cells = [_rate_cell(records(results, p, name)) for p in bench.planners]
+        lines.append(_row([label(name), bench.split_of(name) or "—", *cells, failures or "—"]))
+    return lines

@@ -1,0 +1,282 @@
+"""The outer problem (thesis 3.4.2): the search for the best hand pose, and why none may be feasible.
+
+A grid over x, y within ``d_max`` of the contour's locus (A0, C0) (eq 3.39-3.40,
+:class:`~contourgrasp.synthesis.grid.SearchGrid`) and yaw over [0, 2 pi). A pose is feasible when
+
+* no fingertip starts inside the contour (the hand comes down from above),
+* every touching finger starts at least ``d_min`` from its grasp point
+  (eq 3.41, distance as in eq 3.36 with lambda_virt = 0),
+* every ``required`` finger touches, and at least ``hand.min_touching`` do.
+
+Its cost is that of :mod:`contourgrasp.synthesis.cost`. :func:`search` screens every grid pose
+(:func:`~contourgrasp.synthesis.grid.screen_grid`), then solves the cheapest candidates exactly
+(:func:`~contourgrasp.synthesis.evaluate_poses`: polygon contacts compiled, then Newton onto the
+curve). Optionally (``refine=True``), :func:`~contourgrasp.synthesis.refine_poses` leaves the grid:
+a bounded compass search in (x, y, yaw) from the best distinct grid poses, on the exact cost and
+under the same constraints.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Literal
+
+import numpy as np
+
+from .. import contour as efd_model
+from .. import quality
+from .. import tolerances as tol
+from .. import validation as check
+from ..contour import EFD, CurvatureMode
+from ..errors import HandError, NoFeasibleGrasp, PlannerError
+from ..hand import Hand, to_image
+from ._derived import hand_arrays
+from .cost import distance
+from .evaluate import concatenate, evaluate_poses
+from .grid import SearchGrid, distinct_best, screen_grid
+from .inner import closest_approach
+from .plan import Alternative, Cost, FingerContact, GraspPlan, PoseEvaluation, Refinement
+from .refine import refine_poses
+from .safeguards import Safeguards, grasp_epsilon
+
+
+def search(
+    contour_xy,
+    hand: Hand,
+    *,
+    harmonics: int | Literal["adaptive"] = 4,
+    curvature: CurvatureMode = "paper",
+    xy_step: float = 0.05,
+    yaw_step: float = math.radians(2.0),
+    d_max=(0.15, 0.15),
+    d_min: float = 0.015,
+    top_k: int = 10,
+    refine: bool = False,
+    finger_thickness: bool = False,
+    clearance: float = 0.0,
+    friction: float = 0.5,
+    require_closure: bool = False,
+    quality_gain: float = 0.0,
+) -> GraspPlan:
+    """Plan a grasp on a contour: fit the EFD model, search the pose grid, return the best pose.
+
+    Implements eq 3.32: min over the grid's poses rho of the cost f (eq 3.34) of the inner
+    problem's grasp points (eq 3.22), subject to the constraints g(rho) <= 0 (eq 3.39-3.41).
+
+    Parameters
+    ----------
+    contour_xy : (n, 2) float
+        Closed object contour in the image plane, meters, either orientation.
+    hand : Hand
+        (:func:`contourgrasp.synthesize` also takes a preset name or a TOML path.)
+    harmonics : int or "adaptive"
+        EFD harmonics (thesis: 4; at most ``tolerances.MAX_HARMONICS``); ``"adaptive"`` chooses
+        them per object (:func:`contourgrasp.efd.choose_harmonics` with its defaults).
+    curvature : {"paper", "geometric"}
+        Curvature flavour of the cost, see :mod:`contourgrasp.efd`.
+    xy_step, yaw_step : float
+        Grid resolution, m and rad (Table 4.1: 0.05 m, 2 deg).
+    d_max : float or (2,) float
+        D_max,x and D_max,y, m (Table 4.2: 0.15).
+    d_min : float
+        D_min, m (Table 4.2: 0.015).
+    top_k : int
+        Number of distinct ranked poses to keep in ``alternatives``.
+    refine : bool
+        After the grid, refine its best ``tol.REFINE_STARTS`` distinct poses continuously
+        (:func:`~contourgrasp.synthesis.refine_poses`, under the same constraints) and keep the
+        better; ``refinement`` reports the gain.
+    finger_thickness, clearance, friction, require_closure, quality_gain
+        The :class:`~contourgrasp.synthesis.Safeguards` (all off: the thesis's problem).
+        ``friction`` is also the mu of the plan's reported ``quality``.
+
+    Returns
+    -------
+    GraspPlan
+
+    Raises
+    ------
+    InputError
+        Bad contour (ContourError), hand (HandError) or option (PlannerError, naming it; a grid
+        of more than ``tolerances.MAX_GRID_POSES`` poses is refused before any work).
+    NoFeasibleGrasp
+        No grid pose satisfies the constraints; the message says which one failed.
+
+    Examples
+    --------
+    >>> from contourgrasp import example_contour, load_hand
+    >>> plan = search(example_contour("can"), load_hand("three-finger"), yaw_step=np.radians(10))
+    >>> [f.missed for f in plan.fingers]
+    [False, False, False]
+    """
+    check.choice("curvature", curvature, efd_model.CURVATURE_MODES, error=PlannerError)
+    _check_harmonics(harmonics)
+    check.integer("top_k", top_k, 1, maximum=tol.MAX_GRID_POSES, error=PlannerError)
+    refine = check.flag("refine", refine, error=PlannerError)
+    if not isinstance(hand, Hand):
+        raise HandError(f"hand must be a Hand, got {type(hand).__name__} (contourgrasp.synthesize loads names)")
+    grid = SearchGrid(xy_step=xy_step, yaw_step=yaw_step, d_max=d_max, d_min=d_min)
+    safeguards = Safeguards(finger_thickness=check.flag("finger_thickness", finger_thickness, error=PlannerError),
+                            clearance=clearance, friction=friction,
+                            require_closure=check.flag("require_closure", require_closure, error=PlannerError),
+                            quality_gain=quality_gain)
+
+    clock = time.perf_counter()
+    contour = efd_model.clean_polygon(contour_xy)
+    if harmonics == "adaptive":
+        harmonics = efd_model.choose_harmonics(contour, validate=False)
+    model = efd_model.fit(contour, harmonics, validate=False)
+    fitted = time.perf_counter()
+    screen = screen_grid(model, hand, grid, curvature=curvature)
+    searched = time.perf_counter()
+    if not screen.feasible.any():
+        raise NoFeasibleGrasp(_diagnose(screen, hand, grid))
+    result = _reevaluate_best(model, hand, screen, max(tol.REFINE_CANDIDATES, 4 * top_k), curvature, grid.d_min,
+                              safeguards)
+    ranked = distinct_best(result, grid, top_k)
+    exact = time.perf_counter()
+    refinement, refined_at = None, exact
+    if refine:
+        grid_best = ranked[0]
+        refined = refine_poses(model, hand, result.poses[ranked[:tol.REFINE_STARTS]],
+                               step=(grid.xy_step, grid.yaw_step), d_max=grid.d_max,
+                               curvature=curvature, d_min=grid.d_min, safeguards=safeguards)
+        result = concatenate(refined, result)
+        ranked = distinct_best(result, grid, top_k)
+        refinement = Refinement(tuple(map(float, result.poses[len(refined.poses) + grid_best])),
+                                float(result.cost[len(refined.poses) + grid_best]), float(result.cost[ranked[0]]))
+        refined_at = time.perf_counter()
+    best = ranked[0]
+    fingers = _contacts(model, hand, result, best, curvature)
+    grasp_quality = _quality(model, result, best, friction)
+    timing = {
+        "efd": 1e3 * (fitted - clock),
+        "search": 1e3 * (searched - fitted),
+        "exact": 1e3 * (exact - searched),
+        "refine": 1e3 * (refined_at - exact),
+        "total": 1e3 * (time.perf_counter() - clock),
+    }
+    return GraspPlan(
+        pose=result.poses[best].copy(),
+        cost=_cost(result, best),
+        fingers=fingers,
+        efd=model,
+        hand=hand,
+        contour=contour,
+        curvature_mode=curvature,
+        grid=grid,
+        alternatives=tuple(Alternative(tuple(map(float, result.poses[i])), _cost(result, i)) for i in ranked),
+        grid_size=len(screen.poses),
+        feasible_poses=int(screen.feasible.sum()),
+        timing_ms=timing,
+        refinement=refinement,
+        safeguards=safeguards,
+        quality=grasp_quality,
+    )
+
+
+def _check_harmonics(harmonics) -> None:
+    """An integer in 1..``tolerances.MAX_HARMONICS`` or ``"adaptive"``."""
+    if isinstance(harmonics, str) and harmonics == "adaptive":
+        return
+    if isinstance(harmonics, str) or isinstance(harmonics, bool) or not isinstance(harmonics, (int, np.integer)):
+        raise PlannerError(f"harmonics must be an integer or 'adaptive', got {harmonics!r}")
+    check.integer("harmonics", harmonics, 1, maximum=tol.MAX_HARMONICS, error=PlannerError)
+
+
+def _reevaluate_best(model, hand, screen: PoseEvaluation, n: int, curvature, d_min,
+                     safeguards: Safeguards) -> PoseEvaluation:
+    """Exact evaluation of the n cheapest screened poses, then 4n, 16n, ... until one is feasible."""
+    feasible = np.flatnonzero(screen.feasible)
+    order = feasible[np.argsort(screen.cost[feasible], kind="stable")]
+    while True:
+        result = evaluate_poses(model, hand, screen.poses[order[:n]], curvature=curvature, d_min=d_min,
+                                safeguards=safeguards)
+        if result.feasible.any():
+            return result
+        if n >= len(order):
+            raise NoFeasibleGrasp(_diagnose_exact(result, safeguards))
+        n *= 4
+
+
+def _diagnose_exact(result: PoseEvaluation, safeguards: Safeguards) -> str:
+    """Why no screened pose survives exact evaluation."""
+    n = len(result.poses)
+    if safeguards.finger_thickness and not result.clear.any():
+        return (f"every one of the {n} poses that reach the object has a finger starting closer than its radius + "
+                f"{safeguards.clearance} m to the object or striking it before its grasp point")
+    if safeguards.require_closure and not (result.epsilon > 0).any():
+        return f"none of the {n} poses that reach the object puts its grasp points in force closure"
+    return ("every pose that reaches the object fails a constraint once its contacts are "
+            "computed on the EFD curve itself rather than its polygon")
+
+
+def _quality(model: EFD, result: PoseEvaluation, i: int, friction: float) -> quality.GraspQuality:
+    """Force closure and L1 epsilon of pose i's grasp points (as :func:`grasp_epsilon` grades them).
+
+    The evaluation's own epsilon when the safeguards needed it (same friction and convention), else computed.
+    """
+    eps = float(result.epsilon[i])
+    if np.isnan(eps):
+        eps = float(grasp_epsilon(model, result.grasp_point[i:i + 1], result.t[i:i + 1], result.touching[i:i + 1],
+                                  friction=friction)[0])
+    return quality.GraspQuality(force_closure=eps > 0, epsilon=eps, metric="L1", mu=float(friction))
+
+
+def _cost(result: PoseEvaluation, i: int) -> Cost:
+    return Cost(
+        total=float(result.cost[i]),
+        curvature=float(result.cost_curvature[i]),
+        ratio=float(result.cost_ratio[i]),
+        miss=float(result.cost_miss[i]),
+        quality=float(result.cost_quality[i]),
+    )
+
+
+def _diagnose(result: PoseEvaluation, hand: Hand, grid: SearchGrid) -> str:
+    """Name the first constraint that leaves no pose standing."""
+    n = len(result.poses)
+    if not result.starts_outside.any():
+        return (f"no pose keeps every fingertip outside the object ({n} poses tried): "
+                "the object is larger than the hand")
+    reach = result.starts_outside & result.reaches
+    if not reach.any():
+        names = [f.name for f in hand.fingers if f.required]
+        extra = f" including {', '.join(names)}" if names else ""
+        return (f"no pose brings {hand.min_touching} fingers{extra} onto the object within their travel "
+                f"({n} poses tried): the object is too small or too far from the hand's grasp region")
+    return (f"every pose that reaches the object starts a fingertip closer than D_min = {grid.d_min} m "
+            f"to its grasp point ({int(reach.sum())} poses reach it)")
+
+
+def _contacts(model: EFD, hand: Hand, result: PoseEvaluation, i: int, mode: CurvatureMode):
+    """The :class:`FingerContact` of every finger at pose i; a missed finger's closest approach."""
+    pose = result.poses[i]
+    arrays = hand_arrays(hand)
+    starts = to_image(arrays.starts, pose)
+    virtual = to_image(arrays.virtual_starts, pose)
+    found = []
+    for f, finger in enumerate(hand.fingers):
+        if result.touching[i, f]:
+            found.append((result.t[i, f], result.lam[i, f], result.grasp_point[i, f], 0.0))
+        else:
+            found.append(closest_approach(model, finger, pose))
+    curvatures = efd_model.curvature(model, [t for t, *_ in found], mode)
+    contacts = []
+    for f, (finger, (t, lam, point, gap), kappa) in enumerate(zip(hand.fingers, found, curvatures.tolist())):
+        missed = not result.touching[i, f]
+        contacts.append(FingerContact(
+            name=finger.name,
+            grasp_point=np.asarray(point, dtype=float),
+            t=float(t),
+            lam=float(lam),
+            curvature=kappa,
+            concave=kappa < 0,
+            distance=distance(virtual[f], point),
+            start=starts[f],
+            virtual_start=virtual[f],
+            missed=missed,
+            gap=float(gap),
+        ))
+    return tuple(contacts)

@@ -1,0 +1,186 @@
+"""What the search returns: the plan, its cost, each finger's contact, and the evaluations of many poses."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..contour import EFD
+from ..hand import Hand
+from ..quality import GraspQuality
+
+if TYPE_CHECKING:
+    from .grid import SearchGrid
+    from .safeguards import Safeguards
+
+
+@dataclass(frozen=True, eq=False)
+class PoseEvaluation:
+    """Inner-problem solutions and costs for many poses; arrays are (p,) or (p, n_fingers).
+
+    Attributes
+    ----------
+    poses : (p, 3) float
+    touching : (p, f) bool
+        The finger meets the contour within its travel.
+    lam : (p, f) float
+        Distance travelled to the grasp point, m (NaN where missed).
+    t : (p, f) float
+        EFD parameter of the grasp point (NaN where missed).
+    grasp_point : (p, f, 2) float
+        Image-plane grasp point, m (NaN where missed).
+    distance : (p, f) float
+        dist(t, lambda_virt) of eq 3.36: virtual start to grasp point, m.
+    start_distance : (p, f) float
+        dist(t, 0): actual start to grasp point, m (eq 3.41).
+    curvature : (p, f) float
+        Signed curvature at the grasp point (NaN where missed).
+    start_inside : (p, f) bool
+        The fingertip starts inside the contour.
+    starts_outside : (p,) bool
+        No fingertip starts inside the contour.
+    reaches : (p,) bool
+        Every required finger and at least ``min_touching`` fingers touch.
+    clear : (p,) bool
+        The fingers pass :class:`Safeguards` ``finger_thickness`` (all True when it is off).
+    epsilon : (p,) float
+        Ferrari-Canny epsilon of the grasp points (NaN where not computed).
+    feasible : (p,) bool
+    cost_curvature, cost_ratio, cost_miss, cost_quality, cost : (p,) float
+    """
+
+    poses: np.ndarray
+    touching: np.ndarray
+    lam: np.ndarray
+    t: np.ndarray
+    grasp_point: np.ndarray
+    distance: np.ndarray
+    start_distance: np.ndarray
+    curvature: np.ndarray
+    start_inside: np.ndarray
+    starts_outside: np.ndarray
+    reaches: np.ndarray
+    clear: np.ndarray
+    epsilon: np.ndarray
+    feasible: np.ndarray
+    cost_curvature: np.ndarray
+    cost_ratio: np.ndarray
+    cost_miss: np.ndarray
+    cost_quality: np.ndarray
+    cost: np.ndarray
+
+
+@dataclass(frozen=True)
+class Cost:
+    """The cost of a pose (see eq 3.34) and its parts (``quality``: :class:`Safeguards` ``quality_gain``)."""
+
+    total: float
+    curvature: float
+    ratio: float
+    miss: float
+    quality: float = 0.0
+
+
+@dataclass(frozen=True, eq=False)
+class FingerContact:
+    """Where one finger meets the object at the chosen pose (image plane, meters).
+
+    For a missed finger, ``grasp_point``, ``t``, ``lam`` are the closest approach
+    between its trajectory and the contour, and ``gap`` is their distance.
+    """
+
+    name: str
+    grasp_point: np.ndarray
+    t: float
+    lam: float
+    curvature: float
+    concave: bool
+    distance: float
+    start: np.ndarray
+    virtual_start: np.ndarray
+    missed: bool
+    gap: float
+
+
+@dataclass(frozen=True)
+class Alternative:
+    """A ranked candidate pose (x, y, yaw) and its cost."""
+
+    pose: tuple[float, float, float]
+    cost: Cost
+
+
+@dataclass(frozen=True)
+class Refinement:
+    """What the continuous refinement of :func:`~contourgrasp.synthesis.search` (``refine=True``) gained over the grid.
+
+    Attributes
+    ----------
+    grid_pose : (3,) float
+        The best grid pose (exactly evaluated), before refinement.
+    grid_cost : float
+        Its cost (see eq 3.34).
+    cost : float
+        The plan's cost after refinement, never above ``grid_cost``.
+    """
+
+    grid_pose: tuple[float, float, float]
+    grid_cost: float
+    cost: float
+
+    @property
+    def gain(self) -> float:
+        """grid_cost - cost, >= 0."""
+        return self.grid_cost - self.cost
+
+
+@dataclass(frozen=True, eq=False)
+class GraspPlan:
+    """The result of :func:`~contourgrasp.synthesis.search`.
+
+    Attributes
+    ----------
+    pose : (3,) float
+        Best hand pose (x, y, yaw) in the image plane: m, m, rad.
+    cost : Cost
+    fingers : tuple of FingerContact
+    efd : EFD
+    hand : Hand
+    contour : (n, 2) float
+        The input polygon, cleaned, in its input orientation.
+    curvature_mode : str
+    grid : SearchGrid
+    alternatives : tuple of Alternative
+        The best distinct poses in increasing cost; the first is ``pose``.
+        Distinct: no two are neighbours on the grid in x, y and yaw at once.
+    grid_size : int
+        Poses evaluated.
+    feasible_poses : int
+    timing_ms : dict
+        Wall time per stage, milliseconds: ``efd`` (contour check and fit), ``search`` (grid
+        screen), ``exact`` (exact re-evaluation of the best screened poses), ``refine``
+        (continuous refinement, 0 without it) and ``total``.
+    refinement : Refinement or None
+        The grid's best and the gain of the continuous refinement; None without it.
+    safeguards : Safeguards
+    quality : contourgrasp.quality.GraspQuality
+        Force closure and Ferrari-Canny L1 epsilon of the grasp points (missed fingers excluded).
+    """
+
+    pose: np.ndarray
+    cost: Cost
+    fingers: tuple[FingerContact, ...]
+    efd: EFD
+    hand: Hand
+    contour: np.ndarray
+    curvature_mode: str
+    grid: SearchGrid
+    alternatives: tuple[Alternative, ...]
+    grid_size: int
+    feasible_poses: int
+    timing_ms: dict
+    refinement: Refinement | None
+    safeguards: Safeguards
+    quality: GraspQuality

@@ -1,0 +1,91 @@
+"""Intrinsics and depth images: hole filling, denoising (contourgrasp.perception.camera)."""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import cv2
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy import ndimage
+
+from contourgrasp.perception import Intrinsics, contour_to_metric, denoised_depth, fill_depth_holes, segment, segment_depth
+from contourgrasp.perception import camera as camera_module
+from perception_scenes import CAMERA, render, iou, BAR_CLAMP, needs_data
+
+
+def test_depth_holes_are_filled_when_small():
+    depth, _, truth, _ = render()
+    holed = depth.copy()
+    holed[100:105, 100:105] = 0.0
+    holed[300:303, 500:504] = np.nan
+    holed[20:60, 20:60] = 0.0
+    filled, count = fill_depth_holes(holed, max_hole_px=400)
+    assert count == 25 + 12
+    np.testing.assert_allclose(filled[100:105, 100:105], depth[100:105, 100:105], atol=2e-3)
+    assert np.all(filled[20:60, 20:60] == 0)
+    holed[240, 320] = 0.0
+    assert segment_depth(holed, CAMERA).filled_px == 38
+    assert segment_depth(holed, CAMERA, fill_holes=False).filled_px == 0
+    assert iou(segment_depth(holed, CAMERA).mask, truth) > 0.95
+
+
+@settings(max_examples=100, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), missing=st.floats(0.05, 0.9), max_hole_px=st.sampled_from([1, 6, 40, 10**6]))
+def test_hole_takes_the_nearest_reading_of_the_whole_image(seed, missing, max_hole_px):
+    # The fill looks for readings near the holes only; it must find those of a search over the whole image.
+    rng = np.random.default_rng(seed)
+    depth = rng.uniform(0.5, 1.0, tuple(rng.integers(2, 40, 2)))
+    depth[rng.random(depth.shape) < missing] = 0.0
+    filled, count = fill_depth_holes(depth, max_hole_px=max_hole_px)
+    labels, _ = ndimage.label(depth == 0, structure=np.ones((3, 3)))
+    small = (np.bincount(labels.ravel()) <= max_hole_px)[labels] & (labels > 0)
+    _, (rows, cols) = ndimage.distance_transform_edt(depth == 0, return_indices=True)
+    expected = np.where(small & (depth != 0).any(), depth[rows, cols], depth)
+    np.testing.assert_array_equal(filled, expected)
+    assert count == (small.sum() if (depth != 0).any() else 0)
+
+
+def test_denoised_depth_keeps_readings_next_to_holes():
+    depth = np.full((6, 6), 0.7)
+    depth[:2] = 0.0
+    depth[2, 2] = 0.6  # a nearer speck: filtered out
+    denoised = denoised_depth(depth, depth > 0)
+    assert np.all(denoised[:2] == 0.0)  # windows mostly missing keep their own (missing) reading
+    np.testing.assert_allclose(denoised[2:], 0.7)
+
+
+@pytest.mark.parametrize("corner", [(0, 0), (5, 7), (9, 11)])
+def test_denoised_depth_on_a_box_equals_the_whole_image(corner):
+    rng = np.random.default_rng(1)
+    depth = rng.uniform(0.6, 0.8, (10, 12))
+    depth[rng.random((10, 12)) < 0.3] = 0.0
+    valid = depth > 0
+    rows = np.array([corner[0], 4, 5])
+    cols = np.array([corner[1], 6, 5])
+    np.testing.assert_array_equal(camera_module.denoised_at(depth, valid, rows, cols),
+                                  denoised_depth(depth, valid)[rows, cols])
+
+
+@needs_data
+def test_real_raw_depth_with_holes():
+    from contourgrasp.io.camera_file import read_depth, read_intrinsics
+
+    depth = read_depth(BAR_CLAMP / "depth_0.npy")
+    camera = read_intrinsics(BAR_CLAMP / "primesense_overhead_color.intr")
+    seg = segment(None, depth, camera)
+    assert seg.filled_px > 0 and seg.warnings == ()
+    assert math.degrees(seg.plane.tilt) == pytest.approx(3.7, abs=0.5)
+    metric = contour_to_metric(seg.contour_px, depth, camera, plane=seg.plane, depth_mode="plane")
+    (_, _), sides, _ = cv2.minAreaRect(metric.contour_xy.astype(np.float32))
+    assert 0.07 < min(sides) < 0.09 and 0.10 < max(sides) < 0.13
+
+
+def test_project_inverts_rays():
+    k = Intrinsics(fx=525.0, fy=520.0, cx=319.5, cy=239.5, width=640, height=480)
+    pixels = np.array([[0.0, 0.0], [319.5, 239.5], [600.2, 33.7]])
+    points = k.rays(pixels) * np.array([[0.5], [0.7], [1.3]])
+    np.testing.assert_allclose(k.project(points), pixels, atol=1e-9)

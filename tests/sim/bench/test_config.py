@@ -1,0 +1,61 @@
+"""contourgrasp.sim.bench.config: what a bench runs, refused before any trial when it cannot run."""
+
+import pytest
+
+from contourgrasp.cli import main
+from contourgrasp.errors import SimulationError
+from contourgrasp.sim.bench import Bench, resolve_objects, thesis_objects
+
+
+def run_cli(argv, capsys) -> tuple[int, str]:
+    code = main([str(a) for a in argv])
+    return code, capsys.readouterr().err
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--objects", "can,teapot"], "unknown object 'teapot'"),
+    (["--planners", "paper,oracle"], "oracle"),
+    (["--hand", "five-finger-curved-thumb"], "arc"),
+])
+def test_bad_names_exit_2_and_write_nothing(argv, message, tmp_path, capsys):
+    out = tmp_path / "out"
+    code, err = run_cli(["bench", *argv, "--trials", "1", "--out", out], capsys)
+    assert code == 2 and message in err and len(err.strip().splitlines()) == 1
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("options, message", [
+    ({"objects": ()}, "no object"),
+    ({"trials": 0}, "trials must be an integer >= 1"),
+    ({"trials": 1.5}, "trials must be an integer"),
+    ({"seed": -1}, "seed must be an integer >= 0"),
+    ({"planners": ("paper", "paper")}, "planners must be distinct"),
+])
+def test_a_bench_that_cannot_run_is_a_simulation_error(options, message):
+    setup = {"objects": thesis_objects(["can"]), "trials": 1} | options
+    with pytest.raises(SimulationError, match=message):
+        Bench(**setup)
+
+
+def test_a_named_set_becomes_a_split_and_plain_names_belong_to_none():
+    objects, splits = resolve_objects("can,thesis,can")
+    assert [o.name for o in objects] == ["can", "case", "bottle", "stone1", "stone2"]
+    assert splits == (("thesis", ("can", "case", "bottle", "stone1", "stone2")),)
+    objects, splits = resolve_objects(["case", "can"])
+    assert [o.name for o in objects] == ["case", "can"] and splits == ()
+    bench = Bench(objects=objects, trials=1, splits=(("test", ("can",)),))
+    assert bench.split_of("can") == "test" and bench.split_of("case") is None
+
+
+@pytest.mark.parametrize("splits, message", [
+    ((("test", ("teapot",)),), "split 'test' names teapot"),
+    ((("test", ()),), "split 'test' names no object"),
+])
+def test_a_split_names_objects_the_bench_runs(splits, message):
+    with pytest.raises(SimulationError, match=message):
+        Bench(objects=thesis_objects(["can"]), trials=1, splits=splits)
+
+
+def test_an_unknown_name_is_refused_before_any_object_is_loaded():
+    with pytest.raises(SimulationError, match="unknown object 'teapot'"):
+        resolve_objects("thesis,teapot")

@@ -1,0 +1,100 @@
+"""contourgrasp.sim.bench.journal: trials written as they finish, a killed bench resumed, other settings refused."""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from small_bench import SMALL, serial_bench, trials_without_times  # noqa: F401 -- a fixture
+from contourgrasp.cli import main
+from contourgrasp.sim.bench import JOURNAL, Bench, BenchTrial, digest, settings, thesis_objects, trial_from_dict
+from contourgrasp.sim.trial import TrialRecord
+
+RECORD = dict(object="can", seed=3, success=False, cause="dropped", fingers_in_contact=("thumb", "index"),
+              first_contact=(("thumb", 0.25), ("index", 0.5)), push=0.001, lift=0.12, hold_drift=0.03,
+              pose=(0.01, -0.02, 1.5), approach_depth=0.4, plan_error=None, sim_time=6.1, plan_time=0.1, wall_time=1.0)
+
+
+def run_cli(argv, capsys) -> tuple[int, str]:
+    code = main([str(a) for a in argv])
+    return code, capsys.readouterr().err
+
+
+def test_a_killed_bench_resumes_where_it_stopped(serial_bench, tmp_path, capsys):
+    out = tmp_path / "out"
+    env = os.environ | {"MPLBACKEND": "Agg"}
+    bench = subprocess.Popen([sys.executable, "-m", "contourgrasp.cli", *SMALL, "--workers", "1", "--out", str(out)],
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
+    journal = out / JOURNAL
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and bench.poll() is None:
+        if journal.exists() and journal.read_text().count("\n") >= 4:  # the settings and 3 of 8 trials
+            break
+        time.sleep(0.05)
+    bench.send_signal(signal.SIGKILL)
+    bench.wait()
+    written = journal.read_text().count("\n") - 1
+    assert 3 <= written < 8 and not (out / "trials.json").exists()
+    code = main([*SMALL, "--workers", "1", "--resume", str(out)])
+    printed = capsys.readouterr()
+    assert code == 0, printed.err
+    assert trials_without_times(out) == trials_without_times(serial_bench)
+    assert f"8 trials ({written} kept from" in printed.out
+    assert journal.read_text().count("\n") == 9
+
+
+@pytest.mark.parametrize("change, setting", [
+    (["--trials", "3"], "other trials: 2 there, 3 here"),
+    (["--objects", "can"], "other objects: case there, not here"),
+    (["--planners", "paper,random"], "other planners: centroid-principal-axis there, not here; random here, not there"),
+    (["--seed", "1"], "other seed: 0 there, 1 here"),
+    (["--no-noise"], "other noise: True there, False here"),
+    (["--hand", "three-finger"], "other hand"),
+])
+def test_resume_refuses_another_configuration_and_writes_nothing(serial_bench, change, setting, capsys):
+    before = {p.name: p.read_bytes() for p in serial_bench.iterdir()}
+    code, err = run_cli([*SMALL, *change, "--resume", serial_bench], capsys)
+    assert code == 2 and setting in err and len(err.strip().splitlines()) == 1, err
+    assert {p.name: p.read_bytes() for p in serial_bench.iterdir()} == before
+
+
+def test_resume_needs_a_journal_and_one_folder(tmp_path, capsys):
+    code, err = run_cli([*SMALL, "--resume", tmp_path], capsys)
+    assert code == 2 and "nothing to resume" in err
+    code, err = run_cli([*SMALL, "--resume", tmp_path, "--out", tmp_path / "other"], capsys)
+    assert code == 2 and "name different folders" in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_torn_last_line_is_dropped(tmp_path):
+    bench = Bench(objects=thesis_objects(["can"]), planners=("paper",), trials=2)
+    from contourgrasp.sim.bench import Journal, resume
+
+    with Journal.start(tmp_path, bench) as journal:
+        journal.append(BenchTrial("paper", 0, TrialRecord(**RECORD)))
+    with open(tmp_path / JOURNAL, "a") as file:
+        file.write('{"object": "can", "plan')  # killed while writing the second trial
+    journal, done = resume(tmp_path, bench)
+    journal.close()
+    assert done == (BenchTrial("paper", 0, TrialRecord(**RECORD)),)
+    assert (tmp_path / JOURNAL).read_text().count("\n") == 2 and (tmp_path / JOURNAL).read_text().endswith("}\n")
+
+
+def test_a_record_read_back_equals_the_one_written():
+    from contourgrasp.sim.bench import trial_to_dict
+
+    result = BenchTrial("paper", 3, TrialRecord(**RECORD))
+    again = trial_from_dict(json.loads(json.dumps(trial_to_dict(result))))
+    assert again == result and again.record.first_contact == RECORD["first_contact"]
+    assert trial_to_dict(again) == trial_to_dict(result)
+
+
+def test_settings_name_what_decides_the_trials():
+    one = Bench(objects=thesis_objects(["can", "case"]), planners=("paper",), trials=2)
+    assert settings(one) == settings(Bench(objects=thesis_objects(["can", "case"]), planners=("paper",), trials=2))
+    assert settings(one)["objects"] == ["can", "case"] and settings(one)["trials"] == 2
+    assert digest(one.objects[0]) != digest(one.objects[1])
