@@ -6,6 +6,7 @@ whose scans are convex within the tolerance, so no CoACD runs (and no
 """
 
 import importlib.util
+import io
 
 import numpy as np
 import pytest
@@ -131,3 +132,17 @@ def test_trial_with_the_default_planner_on_a_ycb_object(tmp_path):
     assert record.object == "054_softball"
     assert record.success or record.cause is not None
     assert record.sim_time > 0.5 and record.pose is not None  # planned and executed (wall time: numba compiles once)
+
+
+@needs_ycb
+def test_warm_cache_decomposes_once_and_reports_each_object(tmp_path):
+    ell = np.array([(-0.05, -0.01), (0.05, -0.01), (0.05, 0.01), (-0.03, 0.01), (-0.03, 0.09), (-0.05, 0.09)])
+    path = tmp_path / "ell.stl"
+    trimesh.creation.extrude_triangulation(ell, [(0, 1, 2), (0, 2, 3), (0, 3, 5), (3, 4, 5)], 0.03).export(path)
+    stream = io.StringIO()
+    first = ycb.warm_cache(["ycb:056_tennis_ball", str(path), "can"], cache_dir=tmp_path, stream=stream)
+    assert [(r.name, r.source) for r in first] == [("056_tennis_ball", "convex"), ("ell", "coacd")]  # no "can"
+    assert first[1].pieces >= 2 and 0.9 < first[1].volume_ratio < 1.5 and "CoACD" in stream.getvalue()
+    again = ycb.warm_cache([str(path)], cache_dir=tmp_path, stream=stream)
+    assert again[0].source == "cache" and again[0].pieces == first[1].pieces
+    assert ycb.decomposition_table(first)[-1].startswith("| **total** |")

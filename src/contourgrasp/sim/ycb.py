@@ -316,7 +316,7 @@ def load_object(name: str, *, cache_dir=None) -> ObjectSpec:
     """The :class:`ObjectSpec` of one name of :func:`object_names`: ``ycb:<id>``, a thesis name or a mesh path."""
     if name.startswith(PREFIX):
         return ycb_object(name[len(PREFIX):], cache_dir=cache_dir)
-    return object_spec(name)
+    return object_spec(name) if name in THESIS_OBJECTS else mesh_object(name, cache_dir=cache_dir)
 
 
 def resolve_objects(objects, *, cache_dir=None) -> tuple[ObjectSpec, ...]:
@@ -350,9 +350,9 @@ class Decomposition:
     seconds : float
         Wall time to load the mesh and decompose it (or read the cache).
     pieces : int
-        Convex collision parts (1: the mesh is convex enough).
-    cached : bool
-        The decomposition was already on disk (or not needed).
+        Convex collision parts.
+    source : str
+        ``"convex"`` (the mesh is convex enough: its hull), ``"cache"`` (read from disk) or ``"coacd"`` (decomposed).
     volume_ratio : float
         Volume of the union of the pieces' hulls (summed: an upper bound) over the mesh's; far above 1 flags
         a coarse decomposition, far below 1 a degenerate one.
@@ -361,7 +361,7 @@ class Decomposition:
     name: str
     seconds: float
     pieces: int
-    cached: bool
+    source: str
     volume_ratio: float
 
 
@@ -394,20 +394,20 @@ def _decompose(name: str, cache_dir) -> Decomposition:
     from .objects import _cache_file
 
     path = ycb_mesh_path(name[len(PREFIX):]) if name.startswith(PREFIX) else Path(name)
-    cached = _cache_file(path, 1.0, cache_dir).exists()
+    source = "cache" if _cache_file(path, 1.0, cache_dir).exists() else "coacd"
     started = time.perf_counter()
     spec = load_object(name, cache_dir=cache_dir)
     seconds = time.perf_counter() - started
     hulls = sum(ConvexHull(p.vertices).volume for p in spec.collision)
-    return Decomposition(spec.name, seconds, len(spec.collision), cached or len(spec.collision) == 1,
-                         hulls / _mesh_volume(spec))
+    if len(spec.collision) == 1 and source == "coacd" and not _cache_file(path, 1.0, cache_dir).exists():
+        source = "convex"
+    return Decomposition(spec.name, seconds, len(spec.collision), source, hulls / _mesh_volume(spec))
 
 
 def decomposition_table(results) -> list[str]:
     """Markdown lines: one row per object (seconds, pieces, volume ratio), then the total."""
-    lines = ["| object | s | pieces | hull volume / mesh volume | cached |", "|---|---:|---:|---:|---|"]
-    lines += [f"| {r.name} | {r.seconds:.1f} | {r.pieces} | {r.volume_ratio:.2f} | {'yes' if r.cached else 'no'} |"
-              for r in results]
+    lines = ["| object | s | pieces | hull volume / mesh volume | from |", "|---|---:|---:|---:|---|"]
+    lines += [f"| {r.name} | {r.seconds:.1f} | {r.pieces} | {r.volume_ratio:.2f} | {r.source} |" for r in results]
     lines.append(f"| **total** | {sum(r.seconds for r in results):.0f} | {sum(r.pieces for r in results)} | | |")
     return lines
 
