@@ -36,6 +36,19 @@ def test_stone_pieces_are_convex():
             assert hull_depth(part.vertices) < 1e-9
 
 
+def test_hull_depth_equals_the_distance_to_every_facet_plane():
+    from scipy.spatial import ConvexHull
+
+    rng = np.random.default_rng(7)
+    mug = trimesh.creation.annulus(r_min=0.03, r_max=0.04, height=0.08)  # non-convex: the inner wall is deep
+    for vertices, points in [(rng.normal(size=(300, 3)), rng.normal(size=(800, 3)) * 0.6),
+                             (mug.vertices, np.vstack([mug.vertices, mug.triangles_center]))]:
+        hull = ConvexHull(vertices)
+        brute = (-(points @ hull.equations[:, :3].T + hull.equations[:, 3])).min(axis=1).max()
+        assert hull_depth(vertices, points) == pytest.approx(brute, abs=1e-15)
+    assert hull_depth(mug.vertices, mug.triangles_center) == pytest.approx(0.01, abs=2e-3)
+
+
 def test_unreadable_mesh_names_the_file(tmp_path):
     bad = tmp_path / "broken.obj"
     bad.write_bytes(b"\x00\x01 not a mesh")

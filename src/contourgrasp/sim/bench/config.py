@@ -13,6 +13,7 @@ from ..objects import THESIS_OBJECTS, ObjectSpec, object_spec
 from ..planners import BASELINES, make_planner, synthesis_planner
 from ..scene import Camera, Workspace
 from ..trial import DROPPED, NO_PLAN, PUSHED, SLIPPED, STRUCK, TrialRecord, run_trial
+from ..ycb import OBJECT_SETS, load_object, object_names
 
 #: Success rates of Table 4.4 (real arm and qbHand, 10 trials per object).
 THESIS_SUCCESS = {"can": 0.8, "case": 0.4, "bottle": 0.7, "stone1": 0.2, "stone2": 0.6}
@@ -119,31 +120,6 @@ class BenchTrial:
     planner: str
     trial: int
     record: TrialRecord
-
-
-# Object sets of --objects. The YCB sets (issue 15) come from contourgrasp.sim.ycb once it is merged:
-# its OBJECT_SETS, object_names and load_object then replace the three thesis-only definitions below.
-#: Named object sets ``--objects`` takes; a set named there becomes a split of the report.
-OBJECT_SETS = {"thesis": tuple(THESIS_SUCCESS)}
-
-
-def object_names(objects) -> tuple[str, ...]:
-    """The object names ``objects`` (comma-separated or listed) stands for, sets expanded, in order, each once.
-
-    Raises
-    ------
-    SimulationError
-        An unknown name.
-    """
-    tokens = [t.strip() for t in objects.split(",")] if isinstance(objects, str) else [str(t) for t in objects]
-    names = tuple(dict.fromkeys(n for t in filter(None, tokens) for n in OBJECT_SETS.get(t, (t,))))
-    _known(names)
-    return names
-
-
-def load_object(name: str) -> ObjectSpec:
-    """The :class:`ObjectSpec` of a name of :func:`object_names`."""
-    return object_spec(name)
 
 
 def resolve_objects(objects) -> tuple[tuple[ObjectSpec, ...], tuple[tuple[str, tuple[str, ...]], ...]]:
