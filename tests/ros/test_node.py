@@ -5,6 +5,7 @@ import json
 import signal
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -265,3 +266,23 @@ def test_the_ros_command_without_the_extra_says_install_it(monkeypatch, capsys):
     assert contourgrasp_cli(["ros"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "install contourgrasp[ros]" in err
+
+
+def test_no_object_and_no_feasible_grasp_are_one_line_reasons(ros, tmp_path):
+    default = (Path(contourgrasp.__file__).parent / "data" / "planners" / "default.toml").read_text()
+    planner = tmp_path / "reach-2cm.toml"
+    planner.write_text(default.replace('name = "default"', 'name = "reach-2cm"').replace("d_max = 0.15", "d_max = 0.02"))
+    node, camera = _started(ros, "/odd", segment="depth", planner=str(planner))
+    try:
+        colour, depth, info = good_frame()
+        camera.send(node, colour, depth, info)
+        response = camera.call()
+        assert not response.success and response.message.startswith("no feasible grasp: no pose brings")
+        d = bar_clamp()[1]
+        flat = np.where(d > 0, np.median(d[d > 0]), 0).astype(np.float32)
+        colour, _, _ = good_frame()
+        camera.send(node, colour, image(flat, "32FC1", stamp_seconds(colour.header)))
+        response = camera.call()
+        assert not response.success and "no object found" in response.message and "\n" not in response.message
+    finally:
+        _stopped(ros, node, camera)
