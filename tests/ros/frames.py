@@ -1,9 +1,24 @@
-"""The bundled bar-clamp frame (examples/bar_clamp) as rclpy messages, and a bounded spin for the ROS tests."""
+"""The bundled bar-clamp frame (examples/bar_clamp) as rclpy messages, and a bounded spin for the ROS tests.
+
+Importing this module isolates the session's DDS traffic, before any test
+creates an rclpy context: a random ROS_DOMAIN_ID for the session and discovery
+on localhost only, so every participant (in this process and in the
+`contourgrasp ros` processes the tests start) talks only to the others, over
+the loopback interface. (Not a conftest.py: tests/ import their conftest by name.)
+"""
 
 import array
 import math
+import os
+import random
 import time
 from pathlib import Path
+
+os.environ["ROS_DOMAIN_ID"] = str(random.SystemRandom().randint(1, 101))
+os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+for _name in ("ROS_STATIC_PEERS", "ROS_LOCALHOST_ONLY", "ROS_DISCOVERY_SERVER",
+              "FASTRTPS_DEFAULT_PROFILES_FILE", "FASTDDS_DEFAULT_PROFILES_FILE"):
+    os.environ.pop(_name, None)
 
 from builtin_interfaces.msg import Time
 from sensor_msgs.msg import CameraInfo, Image

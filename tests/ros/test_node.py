@@ -12,6 +12,8 @@ import pytest
 
 rclpy = pytest.importorskip("rclpy", reason="rclpy cannot be imported: install contourgrasp[ros] (make test does)")
 
+from frames import EXAMPLE, FRAME_ID, bar_clamp, camera_info, image, spin_until  # noqa: E402  (isolates DDS first)
+
 from geometry_msgs.msg import PoseStamped  # noqa: E402
 from rcl_interfaces.msg import Log  # noqa: E402
 from rclpy.executors import SingleThreadedExecutor  # noqa: E402
@@ -26,7 +28,6 @@ from contourgrasp.cli import main as contourgrasp_cli  # noqa: E402
 from contourgrasp.errors import InputError  # noqa: E402
 from contourgrasp.ros.messages import pose_matrix, stamp_seconds  # noqa: E402
 from contourgrasp.ros.node import ContourGraspNode  # noqa: E402
-from frames import EXAMPLE, FRAME_ID, bar_clamp, camera_info, image, spin_until  # noqa: E402
 
 TIMEOUT = 60.0
 STAMPS = itertools.count(1000)
@@ -233,11 +234,14 @@ def _ros_command(*ros_args):
     return [sys.executable, "-m", "contourgrasp.cli", "ros", "--ros-args", *ros_args]
 
 
-def test_the_ros_command_exits_2_naming_a_refused_parameter():
-    done = subprocess.run(_ros_command("-p", "segment:=bogus"), capture_output=True, text=True, timeout=TIMEOUT)
+@pytest.mark.parametrize("ros_args, message", [
+    (["-p", "segment:=bogus"], "parameter segment: must be one of auto, rgb, depth, got 'bogus'"),
+    (["-p", "bogus"], "contourgrasp: error: ROS arguments: failed to initialize rcl: Couldn't parse parameter override"),
+], ids=["refused-parameter", "unparsable-argument"])
+def test_the_ros_command_exits_2_with_one_line_for_bad_arguments(ros_args, message):
+    done = subprocess.run(_ros_command(*ros_args), capture_output=True, text=True, timeout=TIMEOUT)
     assert done.returncode == 2
-    assert "parameter segment: must be one of auto, rgb, depth, got 'bogus'" in done.stderr
-    assert "Traceback" not in done.stderr
+    assert message in done.stderr and "Traceback" not in done.stderr
 
 
 def test_the_ros_command_serves_plan_and_stops_on_ctrl_c(ros):

@@ -191,6 +191,10 @@ class ContourGraspNode(Node):
             reason = f"no feasible grasp: {err.reason}" if isinstance(err, NoFeasibleGrasp) else str(err)
             self.get_logger().warning(f"frame {stamp:.3f}: {reason}")
             return False, reason
+        except Exception as err:  # a bug: reported, and the node goes on with the next frame
+            reason = f"internal error (please report): {type(err).__name__}: {err}"
+            self.get_logger().error(f"frame {stamp:.3f}: {reason}")
+            return False, reason
         self.grasp_publisher.publish(messages.pose_stamped(result.T_camera_hand, colour.header))
         self.pregrasp_publisher.publish(messages.pose_stamped(result.T_camera_pregrasp, colour.header))
         self.markers_publisher.publish(messages.plan_markers(result, colour.header))
@@ -214,8 +218,14 @@ class ContourGraspNode(Node):
 
 
 def main(ros_args=()) -> int:
-    """Run the node until shut down (Ctrl-C); ``ros_args`` follow ``--ros-args``. 0, or 2 for a parameter refused."""
-    rclpy.init(args=["contourgrasp", "--ros-args", *ros_args])
+    """Run the node until shut down (Ctrl-C, SIGTERM); ``ros_args`` follow ``--ros-args``.
+
+    Returns 0, or 2 for a parameter refused (logged). Raises :class:`InputError` for ROS arguments rcl cannot parse.
+    """
+    try:
+        rclpy.init(args=["contourgrasp", "--ros-args", *ros_args])
+    except RuntimeError as err:  # rclpy's RCLError: arguments rcl cannot parse
+        raise InputError(f"ROS arguments: {str(err).split(', at /')[0]}") from None
     try:
         node = ContourGraspNode()
     except InputError:
