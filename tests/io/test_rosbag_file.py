@@ -37,7 +37,8 @@ def _header(stamp: float):
 
 def _image(pixels, encoding, stamp):
     fields = image_fields(pixels, encoding)
-    return T["sensor_msgs/msg/Image"](header=_header(stamp), **(fields | {"data": np.frombuffer(fields["data"], np.uint8)}))
+    fields["data"] = np.frombuffer(fields["data"], np.uint8)
+    return T["sensor_msgs/msg/Image"](header=_header(stamp), **fields)
 
 
 def _camera_info(intrinsics, stamp):
@@ -56,7 +57,8 @@ def write_bag(path, frame, depth_encoding, storage, *, frames=2):
         for i in range(frames):
             stamp = 10.0 + i
             near = depth - (20 if depth_encoding == "16UC1" else 0.02) * (i == 0) * (depth > 0)
-            for name, msg in (("info", _camera_info(frame.intrinsics, stamp)), ("color", _image(frame.rgb, "rgb8", stamp)),
+            for name, msg in (("info", _camera_info(frame.intrinsics, stamp)),
+                              ("color", _image(frame.rgb, "rgb8", stamp)),
                               ("depth", _image(near, depth_encoding, stamp + 0.004))):
                 writer.write(connections[name], int(stamp * 1e9), STORE.serialize_cdr(msg, msg.__msgtype__))
     return path
@@ -122,8 +124,8 @@ def _garbage(tmp) -> Path:
 def test_a_depth_image_too_far_in_time_is_no_pair(tmp_path, frame):
     bag = tmp_path / "bag"
     with Writer(bag, version=9) as writer:
-        c = {n: writer.add_connection(TOPICS[n], t, typestore=STORE) for n, t in
-             (("color", "sensor_msgs/msg/Image"), ("depth", "sensor_msgs/msg/Image"), ("info", "sensor_msgs/msg/CameraInfo"))}
+        c = {n: writer.add_connection(TOPICS[n], t, typestore=STORE) for n, t in (
+            ("color", "sensor_msgs/msg/Image"), ("depth", "sensor_msgs/msg/Image"), ("info", "sensor_msgs/msg/CameraInfo"))}
         for name, msg in (("info", _camera_info(frame.intrinsics, 10.0)), ("color", _image(frame.rgb, "rgb8", 10.0)),
                           ("depth", _image(frame.depth.astype(np.float32), "32FC1", 10.5))):
             writer.write(c[name], 10**10, STORE.serialize_cdr(msg, msg.__msgtype__))

@@ -186,8 +186,8 @@ def pose_stamped(T_camera_hand, header):
     msg = PoseStamped()
     msg.header.frame_id, msg.header.stamp = header.frame_id, header.stamp
     msg.pose.position.x, msg.pose.position.y, msg.pose.position.z = (float(v) for v in T[:3, 3])
-    q = Rotation.from_matrix(T[:3, :3]).as_quat()
-    msg.pose.orientation.x, msg.pose.orientation.y, msg.pose.orientation.z, msg.pose.orientation.w = (float(v) for v in q)
+    q = msg.pose.orientation
+    q.x, q.y, q.z, q.w = (float(v) for v in Rotation.from_matrix(T[:3, :3]).as_quat())
     return msg
 
 
@@ -230,9 +230,9 @@ def plan_markers(result, header):
     for i, (finger, contact) in enumerate(zip(plan.hand.fingers, plan.fingers)):
         path = to_image(finger.points(np.linspace(0.0, finger.travel, 30)), plan.pose)
         markers.append(_marker(Marker.LINE_STRIP, "path", i, metric.to_camera(path, depth=tips), header, "path"))
-        markers.append(_marker(Marker.SPHERE, "start", i, metric.to_camera([contact.start], depth=tips), header, "start"))
-        markers.append(_marker(Marker.SPHERE, "grasp", i, metric.to_camera([contact.grasp_point], depth=tips), header,
-                               "missed" if contact.missed else "grasp"))
+        for ns, point in (("start", contact.start), ("grasp", contact.grasp_point)):
+            colour = "missed" if ns == "grasp" and contact.missed else ns
+            markers.append(_marker(Marker.SPHERE, ns, i, metric.to_camera([point], depth=tips), header, colour))
     return MarkerArray(markers=markers)
 
 

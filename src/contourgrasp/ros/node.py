@@ -27,7 +27,7 @@ from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.exceptions import InvalidParameterTypeException
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
-from rclpy.qos import qos_profile_sensor_data
+from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import CameraInfo, Image
 from std_srvs.srv import Trigger
 from visualization_msgs.msg import MarkerArray
@@ -39,6 +39,10 @@ from ..io.plan_file import image_plan_to_dict
 from ..io.planner_file import Planner
 from . import messages
 from .pairing import PAIR_TOLERANCE, Pairer
+
+#: QoS of the subscriptions: best effort (it receives from reliable publishers too), a queue of one, so that a
+#: node busy planning goes on with the newest images rather than falling behind the camera.
+NEWEST = QoSProfile(depth=1, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.BEST_EFFORT)
 
 SEGMENT_CHOICES = ("auto", "rgb", "depth")
 DEPTH_MODE_CHOICES = ("", "max", "plane")
@@ -155,9 +159,9 @@ class ContourGraspNode(Node):
         return values
 
     def _subscribe(self) -> None:
-        self.create_subscription(Image, "color/image_raw", self._on_colour, qos_profile_sensor_data)
-        self.create_subscription(Image, "depth/image_raw", self._on_depth, qos_profile_sensor_data)
-        self.create_subscription(CameraInfo, "color/camera_info", self._on_camera_info, qos_profile_sensor_data)
+        self.create_subscription(Image, "color/image_raw", self._on_colour, NEWEST)
+        self.create_subscription(Image, "depth/image_raw", self._on_depth, NEWEST)
+        self.create_subscription(CameraInfo, "color/camera_info", self._on_camera_info, NEWEST)
 
     def _on_colour(self, msg) -> None:
         self._on_pair(self.pairer.add_colour(messages.stamp_seconds(msg.header), msg), time.perf_counter())
