@@ -164,10 +164,12 @@ class ContourGraspNode(Node):
         self.create_subscription(CameraInfo, "color/camera_info", self._on_camera_info, NEWEST)
 
     def _on_colour(self, msg) -> None:
-        self._on_pair(self.pairer.add_colour(messages.stamp_seconds(msg.header), msg), time.perf_counter())
+        received = time.perf_counter()
+        self._on_pair(self.pairer.add_colour(messages.stamp_seconds(msg.header), msg), received)
 
     def _on_depth(self, msg) -> None:
-        self._on_pair(self.pairer.add_depth(messages.stamp_seconds(msg.header), msg), time.perf_counter())
+        received = time.perf_counter()
+        self._on_pair(self.pairer.add_depth(messages.stamp_seconds(msg.header), msg), received)
 
     def _on_camera_info(self, msg) -> None:
         self.camera_info = msg
