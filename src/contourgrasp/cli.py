@@ -112,9 +112,14 @@ def _parser() -> argparse.ArgumentParser:
 
     plan = sub.add_parser("plan", help="plan a grasp on an RGB-D frame (segmentation -> contour -> 6-DoF pose)")
     plan.add_argument("--rgb", help="colour image (PNG/JPG)")
-    plan.add_argument("--depth", required=True, help="depth: float .npy in meters, or 16-bit PNG / integer .npy")
-    plan.add_argument("--intrinsics", required=True,
+    plan.add_argument("--depth", help="depth: float .npy in meters, or 16-bit PNG / integer .npy (or --bag)")
+    plan.add_argument("--intrinsics",
                       help="YAML/JSON {fx, fy, cx, cy, width, height}, ROS camera_info YAML, or BerkeleyAutomation .intr")
+    plan.add_argument("--bag", help="instead of the files: a rosbag2 recording (directory, .mcap or .db3)")
+    plan.add_argument("--color-topic", help="the bag's colour sensor_msgs/Image topic")
+    plan.add_argument("--depth-topic", help="the bag's depth sensor_msgs/Image topic (16UC1 mm or 32FC1 m)")
+    plan.add_argument("--info-topic", help="the bag's sensor_msgs/CameraInfo topic")
+    plan.add_argument("--bag-index", type=_non_negative_int, default=0, help="which colour image of the bag (from 0)")
     plan.add_argument("--depth-scale", type=_positive_float, default=0.001,
                       help="meters per unit of integer depth images (default 0.001: millimetres)")
     plan.add_argument("--segment", choices=("auto", "rgb", "depth"), default="auto")
@@ -136,6 +141,9 @@ def _parser() -> argparse.ArgumentParser:
 
     _add_bench_parser(sub)
     _add_calibrate_parser(sub)
+    ros = sub.add_parser("ros", help="run the ROS 2 node contourgrasp (needs contourgrasp[ros])")
+    ros.add_argument("--ros-args", nargs=argparse.REMAINDER, default=[], metavar="ARG",
+                     help="ROS arguments: -p NAME:=VALUE, -r FROM:=TO, --params-file FILE, ...")
 
     harm = sub.add_parser("efd", help="approximate a contour with several harmonic counts")
     harm.add_argument("--contour", required=True, help=contour_help)
@@ -290,7 +298,10 @@ def _plan(args) -> int:
     from .io.plan_file import image_plan_to_dict
     from .pipeline import plan_frame
 
-    frame = read_rgbd(args.rgb, args.depth, args.intrinsics, mask_path=args.mask, depth_scale=args.depth_scale)
+    frame = _bag_frame(args) if args.bag else read_rgbd(args.rgb, args.depth, args.intrinsics, mask_path=args.mask,
+                                                        depth_scale=args.depth_scale)
+    if frame.depth is None:
+        raise InputError("plan needs --depth and --intrinsics, or --bag")
     result = plan_frame(
         frame.rgb,
         frame.depth,
@@ -313,6 +324,35 @@ def _plan(args) -> int:
 
     _write_outputs(args, image_plan_to_dict(result), figure, _summary(result.plan))
     return EXIT_OK
+
+
+def _bag_frame(args):
+    from .io.rosbag_file import read_bag_frame
+
+    topics = {"--color-topic": args.color_topic, "--depth-topic": args.depth_topic, "--info-topic": args.info_topic}
+    if missing := [name for name, topic in topics.items() if not topic]:
+        raise InputError(f"--bag needs {', '.join(missing)}")
+    if args.rgb or args.depth or args.intrinsics:
+        raise InputError("--bag replaces --rgb, --depth and --intrinsics: give one or the other")
+    frame = read_bag_frame(args.bag, *topics.values(), index=args.bag_index)
+    if not args.mask:
+        return frame
+    from dataclasses import replace
+
+    from .io.camera_file import read_mask
+    from .validation import same_size
+
+    mask = read_mask(args.mask)
+    same_size(mask.shape, frame.depth.shape, f"{args.mask}", f"the depth image of {args.bag}")
+    return replace(frame, mask=mask)
+
+
+def _ros(args) -> int:
+    try:
+        from .ros.node import main as node_main
+    except ImportError as err:
+        raise InputError(f"the ROS 2 node needs {err.name}: install contourgrasp[ros]") from None
+    return node_main(args.ros_args)
 
 
 def _mesh_names(paths) -> list[str]:
@@ -391,7 +431,7 @@ def _efd(args) -> int:
 
 
 COMMANDS = {"hands": _hands, "synth": _synth, "plan": _plan, "bench": _bench, "efd": _efd,
-            "calibrate": _calibrate}
+            "calibrate": _calibrate, "ros": _ros}
 
 
 def main(argv=None) -> int:

@@ -1,0 +1,247 @@
+"""The ``contourgrasp`` ROS 2 node: plans a grasp on the camera's paired colour and depth images.
+
+Subscribes (remappable) ``color/image_raw`` (rgb8, bgr8, rgba8, bgra8, mono8),
+``depth/image_raw`` (16UC1 millimetres or 32FC1 meters, registered to the
+colour image) and ``color/camera_info``. Colour and depth are paired by stamp
+within ``pair_tolerance`` seconds; a frame without a pair is not planned on.
+
+Serves ``~/plan`` (std_srvs/Trigger): plans on the newest pair and answers the
+plan JSON of ``contourgrasp plan``, or success false with the one-line reason.
+With ``continuous`` it plans every pair as it arrives. Each plan publishes
+``~/grasp`` and ``~/pregrasp`` (geometry_msgs/PoseStamped: T_camera_hand and
+T_camera_pregrasp in the image's frame, at its stamp) and ``~/markers``
+(visualization_msgs/MarkerArray), and logs one line with its time.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+import warnings
+from dataclasses import dataclass, field
+
+import rclpy
+from geometry_msgs.msg import PoseStamped
+from rcl_interfaces.msg import ParameterDescriptor
+from rclpy.exceptions import InvalidParameterTypeException
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import CameraInfo, Image
+from std_srvs.srv import Trigger
+from visualization_msgs.msg import MarkerArray
+
+from .. import load_hand, load_planner, plan_grasp
+from ..errors import InputError, NoFeasibleGrasp
+from ..hand import Hand
+from ..io.plan_file import image_plan_to_dict
+from ..io.planner_file import Planner
+from . import messages
+from .pairing import PAIR_TOLERANCE, Pairer
+
+#: QoS of the subscriptions: best effort (it receives from reliable publishers too), a queue of one, so that a
+#: node busy planning goes on with the newest images rather than falling behind the camera.
+NEWEST = QoSProfile(depth=1, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.BEST_EFFORT)
+
+SEGMENT_CHOICES = ("auto", "rgb", "depth")
+DEPTH_MODE_CHOICES = ("", "max", "plane")
+
+#: The node's parameters: name -> (default, description). Read once at start (read-only).
+PARAMETERS = {
+    "hand": ("five-finger-linear", "hand preset name or hand TOML file"),
+    "planner": ("default", "planner preset name or planner TOML file"),
+    "segment": ("auto", "segmentation: auto, rgb or depth"),
+    "approach_offset": (0.01, "added to the nearest depth inside the contour, m"),
+    "standoff": (0.10, "pre-grasp distance back along the approach axis, m"),
+    "pair_tolerance": (PAIR_TOLERANCE, "largest stamp difference of a colour and a depth image paired, s"),
+    "continuous": (False, "plan every paired frame, not only on ~/plan"),
+    "harmonics": (0, "EFD harmonics; 0: the planner's"),
+    "xy_step": (0.0, "grid step in x and y, m; 0: the planner's"),
+    "yaw_step_deg": (0.0, "grid step in yaw, degrees; 0: the planner's"),
+    "depth_mode": ("", "contour plane: max or plane; empty: the planner's"),
+    "top_k": (10, "ranked distinct poses in the plan JSON"),
+}
+
+
+@dataclass(frozen=True)
+class Settings:
+    """The node's validated parameters: the hand, the planner and the keyword options of ``plan_grasp``."""
+
+    hand: Hand
+    planner: Planner
+    pair_tolerance: float
+    continuous: bool
+    options: dict = field(default_factory=dict)
+
+
+def settings_from_parameters(values: dict) -> Settings:
+    """Validate the parameters' values (``PARAMETERS``' names); :class:`InputError` names the one refused."""
+    v = {name: default for name, (default, _) in PARAMETERS.items()} | values
+    hand = _loaded("hand", load_hand, v["hand"])
+    planner = _loaded("planner", load_planner, v["planner"])
+    _require(v["segment"] in SEGMENT_CHOICES, "segment", f"must be one of {', '.join(SEGMENT_CHOICES)}", v)
+    _require(v["depth_mode"] in DEPTH_MODE_CHOICES, "depth_mode", "must be max, plane or empty", v)
+    _require(math.isfinite(v["approach_offset"]), "approach_offset", "must be a finite distance in m", v)
+    for name in ("standoff", "xy_step", "yaw_step_deg"):
+        _require(math.isfinite(v[name]) and v[name] >= 0, name, "must be a finite number >= 0", v)
+    _require(math.isfinite(v["pair_tolerance"]) and v["pair_tolerance"] > 0, "pair_tolerance",
+             "must be a positive time in s", v)
+    _require(v["harmonics"] >= 0, "harmonics", "must be an integer >= 0 (0: the planner's)", v)
+    _require(v["top_k"] >= 1, "top_k", "must be a positive integer", v)
+    options = {"segment": v["segment"], "approach_offset": v["approach_offset"], "standoff": v["standoff"],
+               "top_k": v["top_k"]}
+    overrides = {"harmonics": v["harmonics"], "xy_step": v["xy_step"], "yaw_step": math.radians(v["yaw_step_deg"]),
+                 "depth_mode": v["depth_mode"]}
+    options |= {name: value for name, value in overrides.items() if value}
+    return Settings(hand, planner, v["pair_tolerance"], v["continuous"], options)
+
+
+def _loaded(name: str, load, value):
+    try:
+        return load(value)
+    except InputError as err:
+        raise InputError(f"parameter {name}: {err}") from None
+
+
+def _require(ok: bool, name: str, what: str, values: dict) -> None:
+    if not ok:
+        raise InputError(f"parameter {name}: {what}, got {values[name]!r}")
+
+
+class ContourGraspNode(Node):
+    """The ``contourgrasp`` node (module docstring); ``kwargs`` go to :class:`rclpy.node.Node`.
+
+    Attributes
+    ----------
+    settings : Settings
+    latencies_ms : list of float
+        Per plan published: time from the message that completed the frame
+        (continuous) or the service call to the poses published, ms.
+
+    Raises
+    ------
+    InputError
+        A parameter refused (logged as an error first; the node is destroyed).
+    """
+
+    def __init__(self, **kwargs):
+        super().__init__("contourgrasp", **kwargs)
+        try:
+            self.settings = settings_from_parameters(self._declared_values())
+        except InputError as err:
+            self.get_logger().error(str(err))
+            self.destroy_node()
+            raise
+        self.pairer = Pairer(self.settings.pair_tolerance)
+        self.camera_info = None
+        self.latencies_ms: list[float] = []
+        self._subscribe()
+        self.grasp_publisher = self.create_publisher(PoseStamped, "~/grasp", 10)
+        self.pregrasp_publisher = self.create_publisher(PoseStamped, "~/pregrasp", 10)
+        self.markers_publisher = self.create_publisher(MarkerArray, "~/markers", 10)
+        self.create_service(Trigger, "~/plan", self._on_plan)
+        self.get_logger().info(
+            f"ready: hand {self.settings.hand.name}, planner {self.settings.planner.name}, "
+            f"{'continuous' if self.settings.continuous else 'on ~/plan'}; colour, depth, camera_info from "
+            f"{', '.join(s.topic_name for s in self.subscriptions)}")
+
+    def _declared_values(self) -> dict:
+        values = {}
+        for name, (default, description) in PARAMETERS.items():
+            try:
+                parameter = self.declare_parameter(name, default, ParameterDescriptor(description=description,
+                                                                                      read_only=True))
+            except InvalidParameterTypeException:
+                kind = {bool: "a bool", int: "an integer", float: "a double (write 1.0, not 1)", str: "a string"}
+                raise InputError(f"parameter {name}: must be {kind[type(default)]}") from None
+            values[name] = parameter.value
+        return values
+
+    def _subscribe(self) -> None:
+        self.create_subscription(Image, "color/image_raw", self._on_colour, NEWEST)
+        self.create_subscription(Image, "depth/image_raw", self._on_depth, NEWEST)
+        self.create_subscription(CameraInfo, "color/camera_info", self._on_camera_info, NEWEST)
+
+    def _on_colour(self, msg) -> None:
+        received = time.perf_counter()
+        self._on_pair(self.pairer.add_colour(messages.stamp_seconds(msg.header), msg), received)
+
+    def _on_depth(self, msg) -> None:
+        received = time.perf_counter()
+        self._on_pair(self.pairer.add_depth(messages.stamp_seconds(msg.header), msg), received)
+
+    def _on_camera_info(self, msg) -> None:
+        self.camera_info = msg
+
+    def _on_pair(self, pair, received: float) -> None:
+        if pair is not None and self.settings.continuous:
+            self.plan(pair, received)
+
+    def _on_plan(self, _request, response):
+        started = time.perf_counter()
+        if self.pairer.newest is None:
+            response.success, response.message = False, (
+                f"no frame yet: no colour and depth image paired within {self.settings.pair_tolerance} s")
+        else:
+            response.success, response.message = self.plan(self.pairer.newest, started)
+        return response
+
+    def plan(self, pair, started: float) -> tuple[bool, str]:
+        """Plan on a (colour, depth) pair and publish; (True, plan JSON) or (False, the reason, logged)."""
+        colour, depth = pair
+        stamp = messages.stamp_seconds(colour.header)
+        try:
+            result = self._planned(colour, depth)
+        except (InputError, NoFeasibleGrasp) as err:
+            reason = f"no feasible grasp: {err.reason}" if isinstance(err, NoFeasibleGrasp) else str(err)
+            self.get_logger().warning(f"frame {stamp:.3f}: {reason}")
+            return False, reason
+        except Exception as err:  # a bug: reported, and the node goes on with the next frame
+            reason = f"internal error (please report): {type(err).__name__}: {err}"
+            self.get_logger().error(f"frame {stamp:.3f}: {reason}")
+            return False, reason
+        self.grasp_publisher.publish(messages.pose_stamped(result.T_camera_hand, colour.header))
+        self.pregrasp_publisher.publish(messages.pose_stamped(result.T_camera_pregrasp, colour.header))
+        self.markers_publisher.publish(messages.plan_markers(result, colour.header))
+        elapsed = 1e3 * (time.perf_counter() - started)
+        self.latencies_ms.append(elapsed)
+        self.get_logger().info(f"frame {stamp:.3f}: {messages.plan_summary(result)}; pose published "
+                               f"{elapsed:.0f} ms after the frame")
+        return True, json.dumps(image_plan_to_dict(result), indent=2)
+
+    def _planned(self, colour, depth):
+        if self.camera_info is None:
+            raise InputError("no camera_info received yet")
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            rgb, d, intrinsics = messages.rgbd_arrays(colour, depth, self.camera_info)
+            result = plan_grasp(rgb, d, intrinsics, self.settings.hand, planner=self.settings.planner,
+                                **self.settings.options)
+        for w in caught:
+            self.get_logger().warning(str(w.message))
+        return result
+
+
+def main(ros_args=()) -> int:
+    """Run the node until shut down (Ctrl-C, SIGTERM); ``ros_args`` follow ``--ros-args``.
+
+    Returns 0, or 2 for a parameter refused (logged). Raises :class:`InputError` for ROS arguments rcl cannot parse.
+    """
+    try:
+        rclpy.init(args=["contourgrasp", "--ros-args", *ros_args])
+    except RuntimeError as err:  # rclpy's RCLError: arguments rcl cannot parse
+        raise InputError(f"ROS arguments: {str(err).split(', at /')[0]}") from None
+    try:
+        node = ContourGraspNode()
+    except InputError:
+        rclpy.try_shutdown()
+        return 2
+    try:
+        rclpy.spin(node)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+    return 0

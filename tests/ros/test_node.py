@@ -1,0 +1,295 @@
+"""The contourgrasp node over real rclpy and Fast DDS on localhost, fed the bundled bar-clamp frame by a second node."""
+
+import itertools
+import json
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+rclpy = pytest.importorskip("rclpy", reason="rclpy cannot be imported: install contourgrasp[ros] (make test does)")
+
+from frames import EXAMPLE, FRAME_ID, bar_clamp, camera_info, image, spin_until  # noqa: E402  (isolates DDS first)
+
+from geometry_msgs.msg import PoseStamped  # noqa: E402
+from rcl_interfaces.msg import Log  # noqa: E402
+from rclpy.executors import SingleThreadedExecutor  # noqa: E402
+from rclpy.node import Node  # noqa: E402
+from rclpy.parameter import Parameter  # noqa: E402
+from sensor_msgs.msg import CameraInfo, Image  # noqa: E402
+from std_srvs.srv import Trigger  # noqa: E402
+from visualization_msgs.msg import MarkerArray  # noqa: E402
+
+import contourgrasp  # noqa: E402
+from contourgrasp.cli import main as contourgrasp_cli  # noqa: E402
+from contourgrasp.errors import InputError  # noqa: E402
+from contourgrasp.ros.messages import pose_matrix, stamp_seconds  # noqa: E402
+from contourgrasp.ros.node import ContourGraspNode  # noqa: E402
+
+TIMEOUT = 60.0
+STAMPS = itertools.count(1000)
+
+
+class Camera:
+    """A second node: the camera driver's three topics, a client of ``~/plan`` and listeners of the node's outputs."""
+
+    def __init__(self, context, executor, namespace="/"):
+        self.executor = executor
+        self.node = Node("camera", namespace=namespace, context=context)
+        self.colour = self.node.create_publisher(Image, "color/image_raw", 5)
+        self.depth = self.node.create_publisher(Image, "depth/image_raw", 5)
+        self.info = self.node.create_publisher(CameraInfo, "color/camera_info", 5)
+        self.client = self.node.create_client(Trigger, "contourgrasp/plan")
+        self.received = {"grasp": [], "pregrasp": [], "markers": [], "log": []}
+        for topic, kind in (("grasp", PoseStamped), ("pregrasp", PoseStamped), ("markers", MarkerArray)):
+            self.node.create_subscription(kind, f"contourgrasp/{topic}", self.received[topic].append, 10)
+        self.node.create_subscription(Log, "/rosout", self.received["log"].append, 100)
+        executor.add_node(self.node)
+
+    def send(self, node, colour, depth, info=None) -> float:
+        """Publish ``info`` until ``node`` holds it, then the images until it has paired them; their stamp."""
+        stamp = stamp_seconds(colour.header)
+        if info is not None:
+            self._until(lambda: self.info.publish(info), lambda: node.camera_info is not None and
+                        list(node.camera_info.k) == list(info.k), "camera_info")
+        self._until(lambda: (self.colour.publish(colour), self.depth.publish(depth)),
+                    lambda: node.pairer.newest_stamp == stamp, f"frame of stamp {stamp}")
+        return stamp
+
+    def _until(self, publish, received, what: str) -> None:
+        for _ in range(int(TIMEOUT / 0.25)):
+            publish()
+            if spin_until(self.executor, received, 0.25):
+                return
+        raise AssertionError(f"the node did not receive the {what} in {TIMEOUT} s")
+
+    def call(self):
+        assert self.client.wait_for_service(timeout_sec=TIMEOUT)
+        future = self.client.call_async(Trigger.Request())
+        assert spin_until(self.executor, future.done, TIMEOUT), "no answer from ~/plan"
+        return future.result()
+
+    def warnings(self, text: str) -> list[str]:
+        return [m.msg for m in self.received["log"] if m.level == Log.WARN and text in m.msg]
+
+
+@pytest.fixture(scope="module")
+def ros():
+    context = rclpy.Context()
+    rclpy.init(context=context)
+    executor = SingleThreadedExecutor(context=context)
+    yield context, executor
+    executor.shutdown(timeout_sec=5)
+    context.try_shutdown()
+
+
+@pytest.fixture(scope="module")
+def reference():
+    rgb, depth, intrinsics = bar_clamp()
+    return contourgrasp.plan_grasp(rgb, depth, intrinsics, "five-finger-linear", planner="default", segment="auto",
+                                   approach_offset=0.01, standoff=0.10, top_k=10)
+
+
+def _started(ros, namespace="/", **overrides):
+    context, executor = ros
+    node = ContourGraspNode(context=context, namespace=namespace,
+                            parameter_overrides=[Parameter(k, value=v) for k, v in overrides.items()])
+    executor.add_node(node)
+    return node, Camera(context, executor, namespace)
+
+
+def _stopped(ros, node, camera):
+    _, executor = ros
+    for n in (node, camera.node):
+        executor.remove_node(n)
+        n.destroy_node()
+
+
+@pytest.fixture(scope="module")
+def rig(ros, reference):
+    node, camera = _started(ros)
+    yield node, camera
+    _stopped(ros, node, camera)
+
+
+def good_frame(stamp=None):
+    rgb, depth, intrinsics = bar_clamp()
+    stamp = next(STAMPS) + 0.25 if stamp is None else stamp
+    return image(rgb, "rgb8", stamp), image(depth.astype(np.float32), "32FC1", stamp), camera_info(intrinsics)
+
+
+def test_plan_answers_the_pose_and_json_of_plan_grasp_and_publishes_it(rig, reference, tmp_path):
+    node, camera = rig
+    stamp = camera.send(node, *good_frame())
+    response = camera.call()
+    assert response.success, response.message
+    plan = json.loads(response.message)
+    np.testing.assert_array_equal(plan["T_camera_hand"], reference.T_camera_hand)
+    np.testing.assert_array_equal(plan["T_camera_pregrasp"], reference.T_camera_pregrasp)
+
+    assert contourgrasp_cli(["plan", "--rgb", str(EXAMPLE / "color_0.png"), "--depth", str(EXAMPLE / "depth_0.npy"),
+                             "--intrinsics", str(EXAMPLE / "primesense_overhead_color.intr"),
+                             "--out", str(tmp_path / "plan.json")]) == 0
+    written = json.loads((tmp_path / "plan.json").read_text())
+    assert {k: v for k, v in plan.items() if k != "timing_ms"} == {k: v for k, v in written.items() if k != "timing_ms"}
+
+    def published(topic):
+        return [m for m in camera.received[topic]
+                if stamp_seconds(m.header if topic != "markers" else m.markers[0].header) == stamp]
+
+    assert spin_until(camera.executor, lambda: all(published(t) for t in ("grasp", "pregrasp", "markers")), TIMEOUT)
+    for topic, T in (("grasp", reference.T_camera_hand), ("pregrasp", reference.T_camera_pregrasp)):
+        pose = published(topic)[-1]
+        assert pose.header.frame_id == FRAME_ID
+        np.testing.assert_allclose(pose_matrix(pose.pose), T, atol=1e-12)
+    markers = published("markers")[-1].markers
+    assert {m.header.frame_id for m in markers} == {FRAME_ID}
+    assert {m.ns for m in markers[1:]} == {"outline", "path", "start", "grasp"}
+    assert camera.warnings("") == []
+
+
+def _unknown_encoding(colour, depth, info):
+    colour.encoding = "yuv422"
+    return colour, depth, info
+
+
+def _sizes_differ(colour, depth, info):
+    _, d, _ = bar_clamp()
+    return colour, image(d[::2, ::2].astype(np.float32), "32FC1", stamp_seconds(colour.header)), info
+
+
+def _k_all_zero(colour, depth, info):
+    info.k = np.zeros(9)
+    return colour, depth, info
+
+
+def _millimetres_in_32fc1(colour, depth, info):
+    _, d, _ = bar_clamp()
+    return colour, image((1000 * d).astype(np.float32), "32FC1", stamp_seconds(colour.header)), info
+
+
+@pytest.mark.parametrize("spoil, reason", [
+    (_unknown_encoding, "encoding 'yuv422'"),
+    (_sizes_differ, "register depth to colour"),
+    (_k_all_zero, "K is all zero"),
+    (_millimetres_in_32fc1, "REP 118 wants meters in 32FC1"),
+], ids=["unknown-encoding", "sizes-differ", "K-all-zero", "millimetres-in-32FC1"])
+def test_a_bad_message_gives_one_warning_and_success_false_then_the_next_good_frame_plans(rig, reference, spoil,
+                                                                                          reason):
+    node, camera = rig
+    camera.send(node, *spoil(*good_frame()))
+    response = camera.call()
+    assert not response.success
+    assert reason in response.message and "\n" not in response.message
+    assert spin_until(camera.executor, lambda: camera.warnings(reason), 10)
+    assert len(camera.warnings(reason)) == 1
+
+    camera.send(node, *good_frame())
+    response = camera.call()
+    assert response.success, response.message
+    np.testing.assert_array_equal(json.loads(response.message)["T_camera_hand"], reference.T_camera_hand)
+
+
+def test_no_frame_until_a_colour_and_a_depth_image_pair_within_the_tolerance(ros):
+    node, camera = _started(ros, "/fresh")
+    try:
+        response = camera.call()
+        assert not response.success and response.message.startswith("no frame yet")
+        colour, depth, info = good_frame()
+        camera.info.publish(info)
+        late = image(bar_clamp()[1].astype(np.float32), "32FC1", stamp_seconds(colour.header) + 0.5)
+        for _ in range(5):
+            camera.colour.publish(colour)
+            camera.depth.publish(late)
+            spin_until(camera.executor, lambda: False, 0.2)
+        assert node.pairer.colour and node.pairer.depth and node.pairer.newest is None
+        assert camera.call().message.startswith("no frame yet")
+    finally:
+        _stopped(ros, node, camera)
+
+
+def test_continuous_plans_every_frame_without_a_call(ros, reference):
+    node, camera = _started(ros, "/live", continuous=True)
+    try:
+        stamp = camera.send(node, *good_frame())
+        assert spin_until(camera.executor, lambda: any(stamp_seconds(g.header) == stamp
+                                                       for g in camera.received["grasp"]), TIMEOUT)
+        grasp = [g for g in camera.received["grasp"] if stamp_seconds(g.header) == stamp][-1]
+        np.testing.assert_allclose(pose_matrix(grasp.pose), reference.T_camera_hand, atol=1e-12)
+        assert node.latencies_ms and all(t > 0 for t in node.latencies_ms)
+    finally:
+        _stopped(ros, node, camera)
+
+
+@pytest.mark.parametrize("name, value", [("segment", "bogus"), ("hand", "no-such-hand"), ("standoff", -0.1),
+                                         ("pair_tolerance", 0.0), ("top_k", 0), ("standoff", 1)])
+def test_an_invalid_parameter_is_refused_at_start_naming_it(ros, name, value):
+    context, _ = ros
+    with pytest.raises(InputError, match=f"^parameter {name}: "):
+        ContourGraspNode(context=context, parameter_overrides=[Parameter(name, value=value)])
+
+
+def _ros_command(*ros_args):
+    return [sys.executable, "-m", "contourgrasp.cli", "ros", "--ros-args", *ros_args]
+
+
+@pytest.mark.parametrize("ros_args, message", [
+    (["-p", "segment:=bogus"], "parameter segment: must be one of auto, rgb, depth, got 'bogus'"),
+    (["-p", "bogus"], "contourgrasp: error: ROS arguments: failed to initialize rcl: Couldn't parse parameter"),
+], ids=["refused-parameter", "unparsable-argument"])
+def test_the_ros_command_exits_2_with_one_line_for_bad_arguments(ros_args, message):
+    done = subprocess.run(_ros_command(*ros_args), capture_output=True, text=True, timeout=TIMEOUT)
+    assert done.returncode == 2
+    assert message in done.stderr and "Traceback" not in done.stderr
+
+
+def test_the_ros_command_serves_plan_and_stops_on_ctrl_c(ros):
+    context, executor = ros
+    process = subprocess.Popen(_ros_command("-r", "__ns:=/command"), stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    camera = Camera(context, executor, "/command")
+    try:
+        assert camera.call().message.startswith("no frame yet")
+        process.send_signal(signal.SIGINT)
+        assert process.wait(timeout=TIMEOUT) == 0
+        assert "Traceback" not in process.stderr.read()
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait(timeout=TIMEOUT)
+        process.stdout.close()
+        process.stderr.close()
+        executor.remove_node(camera.node)
+        camera.node.destroy_node()
+
+
+def test_the_ros_command_without_the_extra_says_install_it(monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, "rclpy", None)
+    monkeypatch.delitem(sys.modules, "contourgrasp.ros.node")
+    assert contourgrasp_cli(["ros"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "install contourgrasp[ros]" in err
+
+
+def test_no_object_and_no_feasible_grasp_are_one_line_reasons(ros, tmp_path):
+    default = (Path(contourgrasp.__file__).parent / "data" / "planners" / "default.toml").read_text()
+    planner = tmp_path / "reach-2cm.toml"
+    planner.write_text(default.replace('name = "default"', 'name = "reach-2cm"')
+                       .replace("d_max = 0.15", "d_max = 0.02"))
+    node, camera = _started(ros, "/odd", segment="depth", planner=str(planner))
+    try:
+        colour, depth, info = good_frame()
+        camera.send(node, colour, depth, info)
+        response = camera.call()
+        assert not response.success and response.message.startswith("no feasible grasp: no pose brings")
+        d = bar_clamp()[1]
+        flat = np.where(d > 0, np.median(d[d > 0]), 0).astype(np.float32)
+        colour, _, _ = good_frame()
+        camera.send(node, colour, image(flat, "32FC1", stamp_seconds(colour.header)))
+        response = camera.call()
+        assert not response.success and "no object found" in response.message and "\n" not in response.message
+    finally:
+        _stopped(ros, node, camera)
