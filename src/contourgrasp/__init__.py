@@ -16,19 +16,41 @@ The pipeline, one module per stage (thesis chapter 3):
 
 from __future__ import annotations
 
-from . import efd, hand, synthesis, validation
-from .contour import EFD
+import importlib
+
 from .errors import ContourError, HandFileError, InputError, NoFeasibleGrasp, PlannerError, UnitWarning
-from .hand import Arc, Finger, Hand, Ray
-from .io.contour_file import example_contour, example_names, read_contour
-from .io.hand_file import load_hand, preset_names
-from .io.planner_file import load_planner, planner_names
-from .synthesis import GraspPlan
+
+# The package's names load on first use (PEP 562), so that ``import contourgrasp`` and a CLI call pay
+# only for the stages they use: numba's kernels, scipy and pydantic cost tenths of a second to import.
+_LAZY = {
+    "efd": (".efd", None), "hand": (".hand", None), "synthesis": (".synthesis", None),
+    "validation": (".validation", None), "EFD": (".contour", "EFD"), "GraspPlan": (".synthesis", "GraspPlan"),
+    "Arc": (".hand", "Arc"), "Finger": (".hand", "Finger"), "Hand": (".hand", "Hand"), "Ray": (".hand", "Ray"),
+    "example_contour": (".io.contour_file", "example_contour"), "example_names": (".io.contour_file", "example_names"),
+    "read_contour": (".io.contour_file", "read_contour"), "load_hand": (".io.hand_file", "load_hand"),
+    "preset_names": (".io.hand_file", "preset_names"), "load_planner": (".io.planner_file", "load_planner"),
+    "planner_names": (".io.planner_file", "planner_names"),
+}
+
+
+def __getattr__(name: str):
+    if name not in _LAZY:
+        raise AttributeError(f"module 'contourgrasp' has no attribute {name!r}")
+    module, attribute = _LAZY[name]
+    value = importlib.import_module(module, __name__)
+    value = value if attribute is None else getattr(value, attribute)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))
+
 
 __version__ = "0.1.0"
 
 
-def synthesize(contour_xy, hand, *, planner=None, **options) -> GraspPlan:
+def synthesize(contour_xy, hand, *, planner=None, **options):
     """Plan a grasp on a metric contour: :func:`contourgrasp.synthesis.search` with names resolved.
 
     ``hand`` is a preset name, a TOML path or a :class:`Hand`; ``planner`` a
@@ -36,6 +58,11 @@ def synthesize(contour_xy, hand, *, planner=None, **options) -> GraspPlan:
     None (the options' defaults, which are the thesis's). ``options`` are
     keyword options of :func:`contourgrasp.synthesis.search` and override
     the planner's.
+
+    Returns
+    -------
+    GraspPlan
+        The best pose, its cost, contacts, quality and alternatives.
 
     Raises
     ------
@@ -48,10 +75,15 @@ def synthesize(contour_xy, hand, *, planner=None, **options) -> GraspPlan:
     Examples
     --------
     >>> import math
+    >>> from contourgrasp import example_contour
     >>> plan = synthesize(example_contour("can"), "three-finger", yaw_step=math.radians(10))
     >>> plan.grid_size
     1764
     """
+    from . import synthesis, validation
+    from .io.hand_file import load_hand
+    from .io.planner_file import load_planner
+
     validation.options("synthesize", options, synthesis.search, error=PlannerError)
     settings = {} if planner is None else load_planner(planner).synthesis_options
     return synthesis.search(contour_xy, load_hand(hand), **(settings | options))
@@ -64,6 +96,8 @@ def plan_grasp(rgb, depth, intrinsics, hand="five-finger-linear", *, planner=Non
     :class:`GraspPlan`, ``.T_camera_hand`` the 6-DoF pose); see
     :func:`contourgrasp.pipeline.plan_frame` for the options, which override the planner's.
     """
+    from .io.hand_file import load_hand
+    from .io.planner_file import load_planner
     from .pipeline import plan_frame
 
     settings = {} if planner is None else load_planner(planner).plan_options

@@ -6,7 +6,5 @@ README and users write ``from contourgrasp.efd import EFD, fit`` or
 harmonics), which modules inside contourgrasp import directly.
 """
 
-from .contour import (CURVATURE_MODES, EFD, HARMONICS_RULES, CurvatureMode, HarmonicsRule, __all__, choose_harmonics,
-                      clean_polygon, concave, curvature, curvature_from_derivatives, evaluate, evaluate_derivatives,
-                      first_self_intersection, fit, fit_adaptive, harmonic_power, repair_self_intersections, sample,
-                      signed_area)
+from .contour import *  # noqa: F403 -- this module is that package's other name
+from .contour import __all__  # noqa: F401

@@ -66,7 +66,6 @@ import itertools
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import ConvexHull, QhullError
 
 from . import tolerances as tol
 from . import validation as check
@@ -301,6 +300,8 @@ def _frame(p, ok, centre, rho) -> tuple[np.ndarray, np.ndarray]:
 
 def _ball_radius(w: np.ndarray) -> float:
     """Radius of the largest origin-centred ball in conv(w), by Qhull; 0 if none or flat."""
+    from scipy.spatial import ConvexHull, QhullError  # scipy loads here: 0.2 s a CLI call need not pay
+
     if len(w) < 4:
         return 0.0
     try:

@@ -1,5 +1,4 @@
 import re
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -200,18 +199,6 @@ def test_contourgrasp_efd_is_the_contour_package():
         assert getattr(contourgrasp.efd, name) is getattr(contour, name)
     assert contourgrasp.efd.choose_harmonics(example_contour("stone2")) == 8
 
-
-def test_each_equation_of_section_3_2_has_one_owner():
-    """Eq 3.3-3.17: exactly one docstring in contourgrasp.contour says "Implements eq 3.N"."""
-    owners = {}
-    for path in Path(contour.__file__).parent.glob("*.py"):
-        for match in re.finditer(r"Implements eq ((?:3\.\d+(?:,| and|\s)*)+)", path.read_text()):
-            for number in re.findall(r"3\.(\d+)", match.group(1)):
-                owners.setdefault(int(number), []).append(path.name)
-    assert {n: len(v) for n, v in owners.items()} == {n: 1 for n in range(3, 18)}
-
-
-# --- fuzz ------------------------------------------------------------------------------------------------
 
 @settings(max_examples=80, deadline=None)
 @given(polygons(), st.integers(-2, 120), st.sampled_from(contour.CURVATURE_MODES))

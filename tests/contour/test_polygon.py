@@ -61,19 +61,6 @@ def test_first_self_intersection_matches_the_full_pairwise_test(n, seed):
     assert contour.first_self_intersection(points) == (pairs[0] if pairs else None)
 
 
-def test_closing_point_and_duplicates_are_dropped():
-    square = [[0, 0], [0.1, 0], [0.1, 0], [0.1, 0.1], [0, 0.1], [0, 0]]
-    assert len(contour.clean_polygon(square)) == 4
-
-
-def test_millimetres_are_warned_about():
-    with pytest.warns(UnitWarning, match="millimetres"):
-        contour.clean_polygon(example_contour("can") * 1000)
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        contour.clean_polygon(example_contour("can"))
-
-
 # --- size bounds: overflow, tiny contours (issue 14) -----------------------------------------------
 
 @pytest.mark.parametrize("scale", [1e5, 1e155, 1e200, 1e307, 1e308])

@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import warnings
 
-import numpy as np
 import pytest
 
 from contourgrasp.perception import segment_depth

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 
-import numpy as np
 
 from contourgrasp.perception import segment_rgb
 from perception_scenes import render, iou

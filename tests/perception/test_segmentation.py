@@ -14,7 +14,7 @@ from hypothesis.extra.numpy import arrays
 from scipy import ndimage
 
 from contourgrasp.errors import InputError
-from contourgrasp.perception import DEPTH_MODES, SEGMENT_METHODS, Intrinsics, PerceptionWarning, SegmentationError, add_flat_parts, approach_depth, colour_offset, contour_to_metric, fill_depth_holes, fit_plane, segment, segment_depth, segment_from_mask, segment_rgb
+from contourgrasp.perception import DEPTH_MODES, SEGMENT_METHODS, Intrinsics, PerceptionWarning, SegmentationError, add_flat_parts, colour_offset, contour_to_metric, fill_depth_holes, fit_plane, segment, segment_depth, segment_from_mask, segment_rgb
 from perception_scenes import H, W, CAMERA, render, iou, needs_data, FOOTPRINTS, TARGET_WORST_IOU, load_frame
 
 

@@ -17,7 +17,6 @@ import numpy as np
 from .. import tolerances as tol
 from .. import validation
 from ..errors import ContourError, UnitWarning
-from ._kernels import first_crossing
 
 
 def signed_area(points: np.ndarray) -> float:
@@ -144,6 +143,8 @@ def first_self_intersection(points: np.ndarray) -> tuple[int, int] | None:
         return None
     unit, _ = _unit_size(p)
     eps = tol.COLLINEAR * float(np.max(np.ptp(unit, axis=0))) ** 2
+    from ._kernels import first_crossing  # numba loads here, not when the package is imported
+
     i, j = first_crossing(unit, eps)
     found = [(int(i), int(j))] if i >= 0 else []
     found += [pair for pair in _shared_vertices(p) if _passes_cross(unit, *pair)]

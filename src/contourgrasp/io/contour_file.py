@@ -12,7 +12,6 @@ from pathlib import Path
 
 import numpy as np
 
-from ..contour import clean_polygon
 from ..errors import ContourError, InputError
 
 _EXAMPLE_DIR = "data/contours"
@@ -50,6 +49,8 @@ def read_contour(path) -> np.ndarray:
     if points.ndim != 2 or points.shape[1] != 2:
         raise InputError(f"{path}: expected two columns x, y (an (n, 2) array), got shape {points.shape}")
     try:
+        from ..contour import clean_polygon
+
         clean_polygon(points, check_units=False)
     except ContourError as err:
         raise ContourError(f"{path}: {err}") from None

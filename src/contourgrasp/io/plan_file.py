@@ -11,11 +11,14 @@ import stat
 import tempfile
 from dataclasses import asdict
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..errors import OutputError
-from ..synthesis import GraspPlan
+
+if TYPE_CHECKING:  # the plan's type only: importing synthesis loads numba
+    from ..synthesis import GraspPlan
 
 
 def _pose(pose) -> dict:

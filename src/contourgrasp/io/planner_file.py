@@ -41,7 +41,6 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from .. import tolerances as tol
 from ..errors import PlannerError
-from ..synthesis import SearchGrid
 from . import _toml_files
 
 _PRESET_DIR = "data/planners"
@@ -82,6 +81,8 @@ class _PlannerSchema(BaseModel):
         """The grid's own checks (its size above all), with the search's defaults for what is unset."""
         grid = {k: getattr(self, k) for k in ("xy_step", "yaw_step", "d_max", "d_min") if getattr(self, k) is not None}
         try:
+            from ..synthesis import SearchGrid
+
             SearchGrid(**grid)
         except PlannerError as err:
             raise ValueError(str(err)) from None
