@@ -391,7 +391,7 @@ def _bench(args) -> int:
             journal = bench.Journal.start(out, setup)
         with journal, bench.console_progress(setup, done=done) as progress:
             results = bench.run_bench(setup, progress, execute=run, done=done, record=journal.append)
-    paths = bench.write_outputs(setup, results, out, wall_time=time.perf_counter() - started)
+    paths = bench.write_outputs(setup, results, out, wall_time=time.perf_counter() - started, kept=len(done))
     print("\n".join(bench.split_table(setup, results) if setup.splits else bench.rates_table(setup, results)))
     kept = f" ({len(done)} kept from {out / bench.JOURNAL})" if done else ""
     print(f"{len(results)} trials{kept} in {time.perf_counter() - started:.0f} s -> {', '.join(map(str, paths))}")

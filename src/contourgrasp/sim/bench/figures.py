@@ -90,8 +90,8 @@ def objects_figure(bench: Bench, results) -> Figure:
         ax.set_xlim(0, 100)
         ax.set_xlabel("success rate [%]", fontsize=8)
         ax.grid(axis="x", alpha=0.3)
-        summary = "; ".join(f"{p} {_split_rate(results, p, members)}" for p in bench.planners)
-        ax.set_title(f"{split} ({len(members)} objects, {bench.trials} trials each): {summary}", fontsize=8)
+        summary = "\n".join(f"{p} {_split_rate(results, p, members)}" for p in bench.planners)
+        ax.set_title(f"{split} ({len(members)} objects, {bench.trials} trials each)\n{summary}", fontsize=8)
     axes[0].legend(loc="lower right", fontsize=7)
     return fig
 

@@ -63,7 +63,7 @@ def trial_from_dict(data: dict) -> BenchTrial:
     return BenchTrial(planner, trial, TrialRecord(**fields))
 
 
-def write_outputs(bench: Bench, results, out, *, wall_time: float) -> list[Path]:
+def write_outputs(bench: Bench, results, out, *, wall_time: float, kept: int = 0) -> list[Path]:
     """Write table.md, trials.json, success.png and trials.png (failures.png too with splits) into ``out``.
 
     ``out`` is created if missing; returns the paths written.
@@ -77,7 +77,7 @@ def write_outputs(bench: Bench, results, out, *, wall_time: float) -> list[Path]
     names = (TABLE, TRIALS, CHART, PICTURE, *((FAILURES,) if bench.splits else ()))
     paths = [out / name for name in names]
     with atomic_outputs(*paths) as (table, trials, chart, picture, *mosaic):
-        Path(table).write_text(markdown(bench, results, wall_time=wall_time), encoding="utf-8")
+        Path(table).write_text(markdown(bench, results, wall_time=wall_time, kept=kept), encoding="utf-8")
         write_json([trial_to_dict(r) for r in results], trials)
         chart_figure = objects_figure(bench, results) if bench.splits else success_figure(bench, results)
         chart_figure.savefig(chart, dpi=110, format="png")
@@ -115,14 +115,14 @@ def _header(first: str, columns, *, left: int = 0) -> list[str]:
     return [_row([first, *columns]), _row(["---", *["---"] * left, *["---:"] * (len(columns) - left)])]
 
 
-def markdown(bench: Bench, results, *, wall_time: float) -> str:
+def markdown(bench: Bench, results, *, wall_time: float, kept: int = 0) -> str:
     """The whole of table.md (:func:`split_markdown` for a bench with splits)."""
     if bench.splits:
-        return split_markdown(bench, results, wall_time=wall_time)
+        return split_markdown(bench, results, wall_time=wall_time, kept=kept)
     lines = [
         "# contourgrasp bench: the grasping experiment of thesis 4.2.4 (Table 4.4), simulated",
         "",
-        _setup_text(bench, len(results), wall_time),
+        _setup_text(bench, len(results), wall_time, kept),
         "",
         *planner_notes(bench, results),
         "",
@@ -145,12 +145,17 @@ def markdown(bench: Bench, results, *, wall_time: float) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _setup_text(bench: Bench, n_trials: int, wall_time: float) -> str:
+def _trials_text(bench: Bench, n_trials: int, wall_time: float, kept: int) -> str:
+    resumed = f" ({kept} of them run earlier and kept by --resume)" if kept else ""
     return (f"{len(bench.objects)} object(s) x {bench.trials} trial(s) x {len(bench.planners)} planner(s) = "
-            f"{n_trials} trials in {wall_time:.0f} s wall time. Hand `{bench.hand.name}` (one tendon, the thesis's "
-            f"finger timing); depth noise {'on' if bench.noise else 'off'}; trial t uses seed {bench.seed} + t, the "
-            f"same scene for every planner. The thesis's rates are from a real arm and hand, ours from the "
-            f"simulation; with {bench.trials} trial(s) per object a rate's standard error is up to "
+            f"{n_trials} trials in {wall_time:.0f} s wall time{resumed}. Hand `{bench.hand.name}` (one tendon, the "
+            f"thesis's finger timing); depth noise {'on' if bench.noise else 'off'}; trial t uses seed {bench.seed} "
+            f"+ t, the same scene for every planner.")
+
+
+def _setup_text(bench: Bench, n_trials: int, wall_time: float, kept: int = 0) -> str:
+    return (f"{_trials_text(bench, n_trials, wall_time, kept)} The thesis's rates are from a real arm and hand, "
+            f"ours from the simulation; with {bench.trials} trial(s) per object a rate's standard error is up to "
             f"{50 / math.sqrt(bench.trials):.0f} points.")
 
 
@@ -232,13 +237,13 @@ def cause_table(bench: Bench, results, planner: str) -> list[str]:
     return lines
 
 
-def split_markdown(bench: Bench, results, *, wall_time: float) -> str:
+def split_markdown(bench: Bench, results, *, wall_time: float, kept: int = 0) -> str:
     """table.md of a bench with splits: setup, planners, per split, per object, the ablation."""
     splits = ", ".join(f"{name} ({len(members)} objects)" for name, members in bench.splits)
     lines = [
         f"# contourgrasp bench: {splits}, simulated",
         "",
-        _split_setup_text(bench, len(results), wall_time),
+        _split_setup_text(bench, len(results), wall_time, kept),
         "",
         *planner_notes(bench, results),
         "",
@@ -267,11 +272,8 @@ def split_markdown(bench: Bench, results, *, wall_time: float) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _split_setup_text(bench: Bench, n_trials: int, wall_time: float) -> str:
-    return (f"{len(bench.objects)} object(s) x {bench.trials} trial(s) x {len(bench.planners)} planner(s) = "
-            f"{n_trials} trials in {wall_time:.0f} s wall time. Hand `{bench.hand.name}` (one tendon, the thesis's "
-            f"finger timing); depth noise {'on' if bench.noise else 'off'}; trial t uses seed {bench.seed} + t, the "
-            f"same scene for every planner. With {bench.trials} trial(s) per object an object's rate has a standard "
+def _split_setup_text(bench: Bench, n_trials: int, wall_time: float, kept: int = 0) -> str:
+    return (f"{_trials_text(bench, n_trials, wall_time, kept)} With {bench.trials} trial(s) per object an object's rate has a standard "
             f"error of up to {50 / math.sqrt(bench.trials):.0f} points; a split's intervals are below.")
 
 
