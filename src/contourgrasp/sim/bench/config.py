@@ -141,7 +141,12 @@ def resolve_objects(objects) -> tuple[tuple[ObjectSpec, ...], tuple[tuple[str, t
     True
     """
     tokens = [t.strip() for t in objects.split(",")] if isinstance(objects, str) else [str(t) for t in objects]
-    specs = tuple(load_object(n) for n in object_names(tokens))
+    from tqdm import tqdm
+
+    # The first run on a machine decomposes every non-convex mesh (CoACD, up to a minute and a half each):
+    # a bar on a terminal says which object it is on; once cached, loading all 41 YCB objects takes seconds.
+    specs = tuple(load_object(n) for n in tqdm(object_names(tokens), desc="loading objects", unit="object",
+                                                 leave=False, disable=None))
     names = [o.name for o in specs]
     splits = tuple((t, tuple(n for n in names if n in OBJECT_SETS[t])) for t in dict.fromkeys(tokens)
                    if t in OBJECT_SETS)
