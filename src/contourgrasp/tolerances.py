@@ -266,3 +266,12 @@ WRENCH_BATCH_ELEMENTS = 2_000_000
 #: Most fingers of a hand: every array of the search has one column per finger (about 65 bytes per
 #: pose and finger on the grid), and no hand the planner is meant for has more fingertips.
 MAX_FINGERS = 10
+
+
+# --- depth images (camera files and ROS messages) ---
+
+#: A median depth above this (m) is almost certainly not in meters.
+MAX_PLAUSIBLE_DEPTH = 20.0
+
+#: A median depth below this (m) is closer than any depth camera measures.
+MIN_PLAUSIBLE_DEPTH = 0.02

@@ -41,6 +41,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from .. import tolerances as tol
 from .. import validation
 from ..errors import InputError, UnitWarning
 from ..perception import Intrinsics
@@ -49,11 +50,6 @@ from ..tolerances import HOMOGENEOUS_ROW, ROTATION_TOLERANCE
 #: Default raw-unit size of integer depth images, m (millimetres).
 DEPTH_SCALE = 0.001
 
-#: A median depth above this (m) is almost certainly not in meters.
-MAX_PLAUSIBLE_DEPTH = 20.0
-
-#: A median depth below this (m) is closer than any depth camera measures.
-MIN_PLAUSIBLE_DEPTH = 0.02
 
 __all__ = [
     "DEPTH_SCALE", "Intrinsics", "RGBDFrame", "read_depth", "read_extrinsics", "read_intrinsics", "read_mask",
@@ -147,10 +143,10 @@ def read_depth(path, *, depth_scale: float = DEPTH_SCALE) -> np.ndarray:
 
 def _check_depth_unit(path, median, scaled):
     hint = "check depth_scale" if scaled else "pass integer millimetres with depth_scale=0.001, or convert to meters"
-    if median > MAX_PLAUSIBLE_DEPTH:
+    if median > tol.MAX_PLAUSIBLE_DEPTH:
         unit = "millimetres (scale 0.001)" if median < 20_000 else "tenths of millimetres or finer (scale 0.0001)"
         message = f"median depth {median:.4g} m: probably {unit}; {hint}"
-    elif median < MIN_PLAUSIBLE_DEPTH:
+    elif median < tol.MIN_PLAUSIBLE_DEPTH:
         message = f"median depth {median:.4g} m is closer than a depth camera measures: already scaled twice? {hint}"
     else:
         return

@@ -19,6 +19,7 @@ import math
 
 import numpy as np
 
+from .. import tolerances as tol
 from ..errors import InputError
 from ..hand import to_image
 from ..perception import Intrinsics
@@ -34,8 +35,6 @@ DEPTH_ENCODINGS = ("16UC1", "32FC1")
 #: Meters per unit of a 16UC1 depth image (REP 118: millimetres).
 MILLIMETRE = 0.001
 
-#: Median valid depths (m) outside this range are in the wrong unit (e.g. millimetres in a 32FC1 image).
-PLAUSIBLE_DEPTH = (0.02, 20.0)
 
 
 def stamp_seconds(header) -> float:
@@ -92,7 +91,7 @@ def depth_image(msg) -> np.ndarray:
     ------
     InputError
         Another encoding, no valid reading, or a median valid depth outside
-        ``PLAUSIBLE_DEPTH`` (millimetres in a 32FC1 image, meters in a 16UC1 one).
+        ``tolerances.MIN_PLAUSIBLE_DEPTH`` to ``MAX_PLAUSIBLE_DEPTH`` (millimetres in a 32FC1 image, meters in a 16UC1 one).
     """
     if msg.encoding not in DEPTH_ENCODINGS:
         raise InputError(f"depth image encoding {msg.encoding!r} is not one of {', '.join(DEPTH_ENCODINGS)}")
@@ -102,7 +101,7 @@ def depth_image(msg) -> np.ndarray:
     if present.size == 0:
         raise InputError(f"{msg.encoding} depth image has no valid reading (all 0 or NaN)")
     median = float(np.median(present))
-    lo, hi = PLAUSIBLE_DEPTH
+    lo, hi = tol.MIN_PLAUSIBLE_DEPTH, tol.MAX_PLAUSIBLE_DEPTH
     if not lo <= median <= hi:
         unit = "millimetres" if msg.encoding == "16UC1" else "meters"
         raise InputError(f"{msg.encoding} depth has median {median:.4g} m, outside {lo:g}-{hi:g} m: "
