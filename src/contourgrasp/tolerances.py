@@ -170,6 +170,11 @@ HEIGHT_MAP_CELL = 0.002
 #: fingers' knuckles lean 3-5 cm further), so every cell a planned pose's fingers pass over is in it.
 HEIGHT_MAP_MARGIN = 0.20
 
+#: Height map: raised cells within this distance (m) of the object's contour or mask points belong to the
+#: object too: the mask's outermost pixels and the contour through their centres stop up to a few pixels
+#: short of the object's edge (the footprint of a tilted camera misses 1-3 px on the object's far side).
+HEIGHT_MAP_OBJECT_BAND = 0.006
+
 #: Height map: the largest cell (m) and margin (m) accepted; beyond them a value is a unit slip.
 MAX_HEIGHT_MAP_CELL = 0.1
 MAX_HEIGHT_MAP_MARGIN = 2.0

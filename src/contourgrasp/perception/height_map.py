@@ -51,9 +51,10 @@ import numpy as np
 
 from .. import validation
 from ..errors import PerceptionError
-from ..tolerances import (HEIGHT_MAP_CELL, HEIGHT_MAP_MARGIN, MAX_HEIGHT_MAP_CELL, MAX_HEIGHT_MAP_CELLS,
+from ..tolerances import (HEIGHT_MAP_CELL, HEIGHT_MAP_MARGIN, HEIGHT_MAP_OBJECT_BAND, MAX_HEIGHT_MAP_CELL, MAX_HEIGHT_MAP_CELLS,
                           MAX_HEIGHT_MAP_MARGIN, MIN_HEIGHT, SENSOR_RANGE)
-from .camera import Intrinsics, as_depth, check_intrinsics, valid_depth
+from ._pixels import dilate
+from .camera import Intrinsics, as_depth, check_intrinsics, denoised_at, pixel_points_at, valid_depth
 from .metric import MetricContour
 from .table import Plane, heights as plane_heights
 
@@ -81,14 +82,18 @@ class HeightMap:
     origin : (2,) float
         Planning-frame (x, y) of the grid's corner: the low-x, low-y edge of cell ``[0, 0]``, m.
     object : (ny, nx) bool
-        The target object's cells: inside its planning-frame contour (the footprint the planner
+        The target object's cells: inside its planning-frame contour (the outline the planner
         closes on), or holding a point of a mask pixel standing at least ``MIN_HEIGHT`` above
-        the table.
+        the table, and the cells standing that high within ``HEIGHT_MAP_OBJECT_BAND`` (6 mm) of
+        those (the band the mask's edge misses).
     obstacles : (ny, nx) bool
         Every other cell standing at least ``MIN_HEIGHT`` (10 mm, the segmentation's threshold)
         above the table: clutter, a bin's wall (today's scenes have none but the sensor's noise).
     max_height : float
-        The object's highest seen cell, m; NaN if none of its cells was seen.
+        Height of the object's highest point, m: the largest height of the readings falling in
+        object cells after a 3 x 3 median filter of the depth (:func:`denoised_depth`, as for the
+        approach depth), since the largest raw reading is the sensor noise's extreme; NaN if no
+        reading falls in an object cell. The cells themselves keep the raw maximum.
     in_view : (ny, nx) bool
         Cells whose column meets the table inside the camera's image.
     table_normal : (3,) float
@@ -183,10 +188,12 @@ class HeightMap:
         """(ny, nx) float: the heights with every unseen cell replaced by an upper bound of its true height.
 
         An unseen cell in view lies in the shadow of an occluder between it and the camera's foot:
-        the ray to its surface passed over the cell at distance s along the way and was stopped
-        there, so with r the cell's distance from the camera's foot, H the camera's height and h
-        the occluder's (seen) height, the cell's surface is at most (h r - H s) / (r - s). The
-        bound is the largest of these over the seen cells on the way (at least 0). An unseen cell
+        the ray to its surface was stopped by a seen point at distance s from the cell on the way,
+        so with r the cell's distance from the camera's foot, H the camera's height and h the
+        occluder's height, the cell's surface is at most h - (H - h) s / (r - s), the line of sight
+        over the occluder. The bound is the largest of these over the seen cells on the way (at
+        least 0), each with the two points taken a cell's diagonal nearer each other, since
+        either may lie anywhere in its cell. An unseen cell
         with no possible occluder in the map takes the map's largest seen height; a cell outside
         the camera's view takes +inf.
 
@@ -209,8 +216,9 @@ class HeightMap:
         toward = self.camera_xy - start
         r = np.hypot(toward[:, 0], toward[:, 1])
         unit = toward / np.maximum(r, 1e-12)[:, None]
-        # Beyond s = top r / H no seen height can hide the cell: (h r - H s) < 0 there.
-        reach = np.minimum(r, max(top, 0.0) * r / self.camera_height)
+        # Beyond s = top r / H (and the cells' diagonals) no seen height can hide the cell.
+        diagonal = math.sqrt(2.0) * self.cell
+        reach = np.minimum(r, max(top, 0.0) * r / self.camera_height + 2 * diagonal)
         span = min(float(np.hypot(*self.shape)) * self.cell, float(reach.max()))
         steps = np.arange(1, int(math.ceil(2 * span / self.cell)) + 1) * (0.5 * self.cell)  # half cells: no cell skipped
         bound = np.empty(len(rows))
@@ -219,8 +227,11 @@ class HeightMap:
             s = np.minimum(steps[None, :], reach[sl, None])
             points = start[sl, None, :] + s[..., None] * unit[sl, None, :]
             h = self.at(points.reshape(-1, 2)).reshape(s.shape)
+            # The occluder's point and the cell's surface may lie anywhere in their cells: the bound takes
+            # them a cell's diagonal nearer each other (which only raises it).
+            gap = np.maximum(s - diagonal, 0.0)
             with np.errstate(invalid="ignore", divide="ignore"):
-                b = (h * r[sl, None] - self.camera_height * s) / (r[sl, None] - s)
+                b = h - (self.camera_height - h) * gap / (r[sl, None] - s + 0.5 * diagonal)
             b[~np.isfinite(b) | (s >= r[sl, None])] = -np.inf
             bound[sl] = b.max(axis=1)
         out[rows, cols] = np.where(bound > -MIN_HEIGHT, np.maximum(bound, 0.0), top)
@@ -341,26 +352,43 @@ def height_map(
     grid[np.isneginf(grid)] = np.nan
     grid = _fill_gaps(grid.reshape(ny, nx))
     obj = obj.reshape(ny, nx) | _inside(metric.contour_xy, lo_xy, cell, (ny, nx))
-
-    table_normal = R.T @ plane.normal
-    table_offset = float(plane.normal @ o + plane.offset)
     seen = np.isfinite(grid)
     with np.errstate(invalid="ignore"):
         raised = seen & (grid >= MIN_HEIGHT)
-    object_seen = obj & seen
+    obj |= raised & dilate(obj, int(math.ceil(HEIGHT_MAP_OBJECT_BAND / cell - 1e-9)))
+
+    table_normal = R.T @ plane.normal
+    table_offset = float(plane.normal @ o + plane.offset)
     return HeightMap(
         heights=grid,
         cell=cell,
         origin=lo_xy,
         object=obj,
         obstacles=raised & ~obj,
-        max_height=float(grid[object_seen].max()) if object_seen.any() else math.nan,
+        max_height=_object_top(d, valid, intrinsics, plane, on_grid, flat, obj.ravel()),
         in_view=_in_view(intrinsics, R, o, table_normal, table_offset, lo_xy, cell, (ny, nx)),
         table_normal=table_normal,
         table_offset=table_offset,
         camera_xy=-o_plane[:2],
         camera_height=float(plane.offset),
     )
+
+
+def _object_top(depth, valid, intrinsics, plane, on_grid, flat, obj):
+    """Height (m) of the object's highest point: the pixels falling in object cells, on the 3 x 3 median-filtered depth.
+
+    The cells keep the largest raw reading (the descent's conservative choice), but the largest
+    of the object's thousands of raw readings is the noise's extreme, several standard deviations
+    above the surface; the filter (:func:`denoised_depth`, as for the approach depth) removes it.
+    NaN when no pixel falls in an object cell.
+    """
+    rows, cols = np.nonzero(on_grid)
+    pick = obj[flat]
+    if not pick.any():
+        return math.nan
+    rows, cols = rows[pick], cols[pick]
+    points = pixel_points_at(denoised_at(depth, valid, rows, cols), intrinsics, rows, cols)
+    return float(plane.height(points).max())
 
 
 def _fill_gaps(grid):
