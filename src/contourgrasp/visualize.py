@@ -145,7 +145,10 @@ def _to_pixels(result, points_xy, shift=(0, 0)) -> np.ndarray:
 
 
 def image_plan_figure(result, rgb=None) -> Figure:
-    """An RGB-D plan: the image with contour, hand and grasp points (left) beside the metric plan (right).
+    """An RGB-D plan: the image with contour, hand and grasp points (left), the metric plan (middle) and the height map.
+
+    The third panel (:func:`draw_heights`) shows ``result.height_map`` under the planned
+    hand's finger paths; without a height map (no table plane) the figure has the first two only.
 
     ``result`` is a :class:`contourgrasp.pipeline.ImageGraspPlan`; ``rgb`` the
     colour image (the depth-derived mask is shown when it is None). Over a
@@ -153,7 +156,7 @@ def image_plan_figure(result, rgb=None) -> Figure:
     is drawn less the colour offset, so that it lines up with the colour.
     """
     plan = result.plan
-    heights = getattr(result, "height_map", None)
+    heights = result.height_map
     if heights is None:
         fig = Figure(figsize=(16, 7), layout="constrained")
         image_ax, plan_ax = fig.subplots(1, 2, width_ratios=[1.2, 1])
