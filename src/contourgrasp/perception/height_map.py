@@ -24,7 +24,8 @@ A hand descending along the approach axis must stay above *every* surface point 
 above their mean: a cell that holds a rim and the table beside it is blocked at the rim's height.
 The maximum is the conservative choice; it also keeps a flying pixel between an object's edge and
 the table (a depth reading half-way between the two), which errs toward caution. Sensor noise
-biases it up by about one standard deviation (2 mm at 0.7 m for the simulated sensor).
+biases it up, by the largest of a cell's few noisy readings; ``max_height`` avoids that bias (see
+:class:`HeightMap`).
 
 Unseen cells
 ------------
@@ -39,6 +40,14 @@ such line over the seen cells on the way from the cell toward the camera's foot.
 cell of the map could hide it (a hole in the readings, or the occluder outside the map) the bound
 is the map's largest seen height, and outside the camera's view it is +inf (a pose whose hand
 passes there is not checkable and should be refused).
+
+For the descent check
+---------------------
+Sample each finger's capsules and the palm at the grasp depth in planning coordinates (the
+hand's pose turned and placed as :func:`contourgrasp.pipeline.hand_pose` does), look up the cells
+under them (:meth:`HeightMap.cell_index`, or :meth:`HeightMap.at` on :meth:`HeightMap.conservative`
+for the bounded layer), and compare the body's lowest height there (:meth:`HeightMap.height_of`
+minus the capsule's radius) with the cell's: a body below the map on the way down strikes.
 """
 
 from __future__ import annotations
