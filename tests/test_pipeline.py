@@ -10,6 +10,7 @@ import pytest
 import contourgrasp as cg
 from contourgrasp.cli import main
 from contourgrasp.io.camera_file import read_extrinsics, read_intrinsics, read_mask, read_rgbd
+from contourgrasp.io.plan_file import image_plan_to_dict
 
 REPO = Path(__file__).resolve().parents[1]
 FRAME = REPO / "examples" / "bar_clamp"
@@ -101,7 +102,38 @@ def test_plan_json_has_the_pose_fields(tmp_path, capsys):
         assert key in data
     assert set(data["camera"]) >= {"fx", "fy", "cx", "cy"}
     assert set(data["segmentation"]) >= {"method", "area_px", "contour_px", "invalid_depth_px"}
+    assert set(data["height_map"]) == {"cell", "shape", "origin", "extent", "object_max_height", "obstacle_max_height"}
     assert (tmp_path / "p.png").stat().st_size > 10000
+
+
+def test_the_height_map_lines_up_with_the_plan():
+    # Issue 16: the height map is in the planning frame of the plan, around the object by the hand's reach.
+    frame = bundled()
+    result = cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, "five-finger-linear", **FAST)
+    hm = result.height_map
+    assert hm is not None and hm.cell == 0.002
+    x0, x1, y0, y1 = hm.extent
+    contour = result.metric.contour_xy
+    np.testing.assert_allclose([x0, y0], contour.min(axis=0) - 0.2)
+    assert x1 >= contour[:, 0].max() + 0.2 and y1 >= contour[:, 1].max() + 0.2
+    # The hand's pose and every finger's start lie on the grid.
+    starts = np.array([f.start for f in result.plan.fingers] + [result.plan.pose[:2]])
+    assert hm.cell_index(starts)[2].all()
+    assert hm.object.sum() > 1000
+    # The bar clamp stands 3-6 cm above the table; the gripper's fingers at the image's bottom edge are obstacles.
+    assert 0.03 < hm.max_height < 0.07
+    assert hm.obstacles.any() and hm.obstacle_max_height > 0.1
+    summary = image_plan_to_dict(result)["height_map"]
+    assert summary["shape"] == list(hm.shape) and summary["object_max_height"] == hm.max_height
+
+
+def test_a_user_mask_gets_a_height_map_on_the_refitted_table():
+    frame = bundled()
+    auto = cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, "three-finger", **FAST)
+    masked = cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, "three-finger", mask=auto.segmentation.mask,
+                           **FAST)
+    assert masked.segmentation.plane is None and masked.height_map is not None
+    assert masked.height_map.max_height == pytest.approx(auto.height_map.max_height, abs=1e-9)
 
 
 def test_footprint_can_be_forced_either_way():

@@ -63,3 +63,17 @@ def test_harmonics_figure_draws_any_contour_the_model_accepts(tmp_path, size, la
     assert {bar.txt_label.get_text() for bar in bars} == {label}
     with pytest.raises(cg.ContourError, match="too large"):
         visualize.harmonics_figure(can * 1e307)
+
+
+def test_image_plan_figure_has_a_height_panel(tmp_path):
+    folder = Path(__file__).resolve().parents[1] / "examples" / "bar_clamp"
+    frame = read_rgbd(folder / "color_0.png", folder / "depth_0.npy", folder / "primesense_overhead_color.intr")
+    result = cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, "three-finger", xy_step=0.03,
+                           yaw_step=math.radians(6))
+    fig = visualize.image_plan_figure(result, frame.rgb)
+    height_ax = fig.axes[2]
+    assert height_ax.get_title().startswith("height map (2 mm cells)")
+    assert height_ax.images[0].get_array().shape == result.height_map.shape
+    fig.savefig(tmp_path / "p.png")
+    # Without a height map (no table plane), the two panels of before.
+    assert len(visualize.image_plan_figure(replace(result, height_map=None)).axes) == 2

@@ -27,9 +27,9 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from . import perception, validation
-from .errors import HandError, PerceptionError, PlannerError
+from .errors import HandError, PerceptionError, PlannerError, SegmentationError
 from .hand import Hand
-from .perception import Intrinsics, MetricContour, Segmentation
+from .perception import HeightMap, Intrinsics, MetricContour, Segmentation
 from .perception.camera import check_intrinsics
 from .synthesis import GraspPlan, search
 from .tolerances import APPROACH_OFFSET, HOMOGENEOUS_ROW, MAX_APPROACH_OFFSET, MAX_STANDOFF, ROTATION_TOLERANCE
@@ -56,6 +56,9 @@ class ImageGraspPlan:
         The grasp pose in the robot's base frame, when extrinsics were given.
     filled_depth_px : int
         Depth holes filled before use.
+    height_map : HeightMap or None
+        Heights above the table around the object, in the planning frame of ``metric``
+        (:func:`contourgrasp.perception.height_map`); None when no table plane was found.
     """
 
     plan: GraspPlan
@@ -66,6 +69,7 @@ class ImageGraspPlan:
     T_camera_pregrasp: np.ndarray
     T_base_hand: np.ndarray | None
     filled_depth_px: int
+    height_map: HeightMap | None = None
 
     @property
     def quaternion_xyzw(self) -> np.ndarray:
@@ -152,15 +156,17 @@ def plan_frame(
         T_base_camera = validation.rigid_transform("T_base_camera", T_base_camera, error=PerceptionError,
                                                    rotation_tolerance=ROTATION_TOLERANCE,
                                                    row_tolerance=HOMOGENEOUS_ROW)
-    seg, metric, filled = perceive(rgb, depth, intrinsics, segment=segment, mask=mask, depth_mode=depth_mode,
-                                   footprint=footprint, fill_holes=fill_holes, colour_offset_px=colour_offset_px,
-                                   approach_offset=approach_offset)
+    seg, metric, filled, d = _perceive(rgb, depth, intrinsics, segment=segment, mask=mask, depth_mode=depth_mode,
+                                       footprint=footprint, fill_holes=fill_holes, colour_offset_px=colour_offset_px,
+                                       approach_offset=approach_offset)
+    heights = scene_heights(d, intrinsics, seg, metric)
     plan = search(metric.contour_xy, hand, **synthesis_options)
     T_camera_hand = hand_pose(metric, plan.pose, metric.approach_depth)
     T_camera_pregrasp = T_camera_hand.copy()
     T_camera_pregrasp[:3, 3] -= standoff * T_camera_hand[:3, 2]
     T_base_hand = None if T_base_camera is None else T_base_camera @ T_camera_hand
-    return ImageGraspPlan(plan, seg, metric, intrinsics, T_camera_hand, T_camera_pregrasp, T_base_hand, filled)
+    return ImageGraspPlan(plan, seg, metric, intrinsics, T_camera_hand, T_camera_pregrasp, T_base_hand, filled,
+                          heights)
 
 
 def perceive(
@@ -181,6 +187,13 @@ def perceive(
     Checks the depth, fills small holes, segments (or takes ``mask``) and puts
     the contour in meters; the options are :func:`plan_frame`'s.
     """
+    return _perceive(rgb, depth, intrinsics, segment=segment, mask=mask, depth_mode=depth_mode, footprint=footprint,
+                     fill_holes=fill_holes, colour_offset_px=colour_offset_px, approach_offset=approach_offset)[:3]
+
+
+def _perceive(rgb, depth, intrinsics, *, segment, mask, depth_mode, footprint, fill_holes, colour_offset_px,
+              approach_offset):
+    """:func:`perceive`, and the depth image it worked on (holes filled)."""
     _check_options(intrinsics, segment, depth_mode, footprint, fill_holes, colour_offset_px, approach_offset)
     d = perception.as_depth(depth)
     intrinsics.check_shape(d.shape, "depth image")
@@ -199,7 +212,37 @@ def perceive(
         seg.contour_px, d, intrinsics, depth_mode=depth_mode, plane=seg.plane, on_table=seg.on_table,
         offset=approach_offset,
     )
-    return seg, metric, filled
+    return seg, metric, filled, d
+
+
+def scene_heights(depth, intrinsics: Intrinsics, segmentation: Segmentation, metric: MetricContour) -> HeightMap | None:
+    """The height map of :func:`plan_frame` (:func:`contourgrasp.perception.height_map`, default cell and margin).
+
+    The table is the segmentation's plane; a user's mask or the RGB method brings none, and it is
+    fitted then (the same fit :func:`contourgrasp.perception.contour_to_metric` made). None when
+    there is no table plane in the depth image.
+
+    Parameters
+    ----------
+    depth : (H, W) float
+        The depth image perception worked on (holes filled).
+    intrinsics : Intrinsics
+    segmentation : Segmentation
+    metric : MetricContour
+
+    Returns
+    -------
+    HeightMap or None
+    """
+    plane = segmentation.plane
+    if plane is None:
+        if metric.tilt is None:  # contour_to_metric found no table either
+            return None
+        try:
+            plane = perception.fit_table_plane(depth, intrinsics)
+        except SegmentationError:
+            return None
+    return perception.height_map(depth, intrinsics, plane, metric, segmentation.mask)
 
 
 def _check_options(intrinsics, segment, depth_mode, footprint, fill_holes, colour_offset_px, approach_offset):

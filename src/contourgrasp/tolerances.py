@@ -160,6 +160,29 @@ APPROACH_OFFSET = 0.01
 #: 2 mm at 0.7 m, 2 mm after the filter) and on single flying pixels; features 2 px wide survive it.
 APPROACH_MEDIAN_PX = 3
 
+#: Height map (perception.height_map): side of a cell, m. 2 mm is about one and a half depth pixels at
+#: the working distance (1.3 mm at 0.7 m with a 525 px focal length), so nearly every cell holds a reading,
+#: and a fifth of the simulated fingers' 9 mm radius.
+HEIGHT_MAP_CELL = 0.002
+
+#: Height map: the grid reaches this far (m) beyond the object's contour on every side, at least the
+#: hand's reach (the presets' fingertips start at most 0.1 m from the reference point, the simulated
+#: fingers' knuckles lean 3-5 cm further), so every cell a planned pose's fingers pass over is in it.
+HEIGHT_MAP_MARGIN = 0.20
+
+#: Height map: raised cells within this distance (m) of the object's contour or mask points belong to the
+#: object too: the mask's outermost pixels and the contour through their centres stop up to a few pixels
+#: short of the object's edge (the footprint of a tilted camera misses 1-3 px on the object's far side).
+HEIGHT_MAP_OBJECT_BAND = 0.006
+
+#: Height map: the largest cell (m) and margin (m) accepted; beyond them a value is a unit slip.
+MAX_HEIGHT_MAP_CELL = 0.1
+MAX_HEIGHT_MAP_MARGIN = 2.0
+
+#: Height map: most cells. 4 M cells of float64 heights and two bool masks are about 40 MB; the default
+#: map of a 15 cm object is 275 x 275 = 76 k cells. A cell so small that the grid would exceed this is refused.
+MAX_HEIGHT_MAP_CELLS = 4_000_000
+
 #: A pixel ray meeting the planning plane at a cosine below this is refused as grazing.
 MIN_RAY_COSINE = 0.05
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
+import matplotlib
 import numpy as np
 from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
@@ -144,7 +145,10 @@ def _to_pixels(result, points_xy, shift=(0, 0)) -> np.ndarray:
 
 
 def image_plan_figure(result, rgb=None) -> Figure:
-    """An RGB-D plan: the image with contour, hand and grasp points (left) beside the metric plan (right).
+    """An RGB-D plan: the image with contour, hand and grasp points (left), the metric plan (middle) and the height map.
+
+    The third panel (:func:`draw_heights`) shows ``result.height_map`` under the planned
+    hand's finger paths; without a height map (no table plane) the figure has the first two only.
 
     ``result`` is a :class:`contourgrasp.pipeline.ImageGraspPlan`; ``rgb`` the
     colour image (the depth-derived mask is shown when it is None). Over a
@@ -152,8 +156,13 @@ def image_plan_figure(result, rgb=None) -> Figure:
     is drawn less the colour offset, so that it lines up with the colour.
     """
     plan = result.plan
-    fig = Figure(figsize=(16, 7), layout="constrained")
-    image_ax, plan_ax = fig.subplots(1, 2, width_ratios=[1.2, 1])
+    heights = result.height_map
+    if heights is None:
+        fig = Figure(figsize=(16, 7), layout="constrained")
+        image_ax, plan_ax = fig.subplots(1, 2, width_ratios=[1.2, 1])
+    else:
+        fig = Figure(figsize=(22, 7), layout="constrained")
+        image_ax, plan_ax, height_ax = fig.subplots(1, 3, width_ratios=[1.2, 1, 0.9])
     seg = result.segmentation
     image_ax.imshow(rgb if rgb is not None else seg.mask, cmap="gray")
     shift = np.asarray(seg.colour_offset_px if rgb is not None and seg.colour_offset_px is not None else (0, 0))
@@ -182,4 +191,39 @@ def image_plan_figure(result, rgb=None) -> Figure:
     plan_ax.set_title(f"{plan.hand.name} in the {result.metric.frame} plane: x={x:.3f} m, y={y:.3f} m, "
                       f"yaw={math.degrees(yaw):.0f}°, cost {plan.cost.total:.1f}", fontsize=10)
     plan_ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    if heights is not None:
+        draw_heights(height_ax, heights, plan, fig)
     return fig
+
+
+def draw_heights(ax, heights, plan: GraspPlan | None = None, fig: Figure | None = None) -> None:
+    """Draw a :class:`~contourgrasp.perception.HeightMap` on ``ax``, height-coloured, unseen cells grey.
+
+    With ``plan`` (planned in the same planning frame) the contour, the finger paths and the
+    starts are drawn over it and the view is cropped to them; ``fig`` adds a colour bar.
+    """
+    x0, x1, y0, y1 = heights.extent
+    cmap = matplotlib.colormaps["viridis"].with_extremes(bad="0.8")
+    top = max(heights.max_height if np.isfinite(heights.max_height) else 0.0, 0.01)
+    image = ax.imshow(1e3 * heights.heights, extent=(x0, x1, y1, y0), origin="upper", cmap=cmap, vmin=0.0,
+                      vmax=1e3 * top, interpolation="nearest")
+    if fig is not None:
+        fig.colorbar(image, ax=ax, shrink=0.8, label="height above the table [mm] (grey: unseen)")
+    if plan is not None:
+        ax.plot(*np.vstack([plan.contour, plan.contour[:1]]).T, color="white", lw=1, label="contour")
+        points = [plan.contour]
+        for i, (finger, contact) in enumerate(zip(plan.hand.fingers, plan.fingers)):
+            colour = FINGER_COLOURS[i % len(FINGER_COLOURS)]
+            path = to_image(finger.points(np.linspace(0, finger.travel, 30)), plan.pose)
+            ax.plot(*path.T, color=colour, lw=1.5, ls="--" if contact.missed else "-")
+            ax.plot(*contact.start, "o", color=colour, mfc="white")
+            points.append(path)
+        lo, hi = np.vstack(points).min(axis=0) - 0.03, np.vstack(points).max(axis=0) + 0.03
+        ax.set_xlim(max(lo[0], x0), min(hi[0], x1))
+        ax.set_ylim(min(hi[1], y1), max(lo[1], y0))
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m] (planning frame)")
+    ax.set_ylabel("y [m]")
+    obstacles = f", obstacles up to {1e3 * heights.obstacle_max_height:.0f} mm" if heights.obstacles.any() else ""
+    ax.set_title(f"height map ({1e3 * heights.cell:g} mm cells): object up to "
+                 f"{1e3 * heights.max_height:.0f} mm{obstacles}", fontsize=10)

@@ -81,6 +81,26 @@ def plan_to_dict(plan: GraspPlan) -> dict:
     }
 
 
+def height_map_summary(heights) -> dict | None:
+    """The plan file's summary of a :class:`~contourgrasp.perception.HeightMap` (not its array), None for None.
+
+    ``{cell, shape: [ny, nx], origin: [x, y], extent: [x_min, x_max, y_min, y_max], object_max_height,
+    obstacle_max_height}``, in m and the planning frame; ``object_max_height`` is null when no
+    object cell was seen.
+    """
+    if heights is None:
+        return None
+    top = heights.max_height
+    return {
+        "cell": heights.cell,
+        "shape": list(heights.shape),
+        "origin": [float(v) for v in heights.origin],
+        "extent": list(heights.extent),
+        "object_max_height": None if math.isnan(top) else top,
+        "obstacle_max_height": heights.obstacle_max_height,
+    }
+
+
 def image_plan_to_dict(result) -> dict:
     """``plan_to_dict`` of the planar plan plus the camera, segmentation and 6-DoF poses of an ImageGraspPlan."""
     data = plan_to_dict(result.plan)
@@ -105,6 +125,7 @@ def image_plan_to_dict(result) -> dict:
         "origin": metric.origin.tolist(),
     }
     data["approach_depth"] = metric.approach_depth
+    data["height_map"] = height_map_summary(result.height_map)
     data["T_camera_hand"] = result.T_camera_hand.tolist()
     data["quaternion_xyzw"] = result.quaternion_xyzw.tolist()
     data["T_camera_pregrasp"] = result.T_camera_pregrasp.tolist()

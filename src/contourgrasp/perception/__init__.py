@@ -15,6 +15,8 @@ One module per stage, in the order the pipeline runs them:
   rule), a user's mask
 * :mod:`~contourgrasp.perception.metric` -- pixels to meters in the planning plane (eq 3.1-3.2),
   the approach depth (3.1.1)
+* :mod:`~contourgrasp.perception.height_map` -- heights above the table on a grid in the planning
+  frame, the object's cells marked (:class:`HeightMap`)
 
 Conventions: see :mod:`~contourgrasp.perception.camera`. The thresholds are in
 :mod:`contourgrasp.tolerances`; measured results (IoU against the hand-made
@@ -26,6 +28,7 @@ from __future__ import annotations
 from ..errors import PerceptionError, PerceptionWarning, SegmentationError
 from .camera import Intrinsics, as_depth, backproject, denoised_depth, fill_depth_holes, valid_depth
 from .colour import add_flat_parts, colour_offset, register_colour
+from .height_map import HeightMap, height_map
 from .metric import DEPTH_MODES, DepthMode, MetricContour, approach_depth, contour_to_metric
 from .region import Segmentation, mask_contour
 from .segment_depth import object_footprint, segment_depth
@@ -34,9 +37,9 @@ from .segmentation import SEGMENT_METHODS, SegmentMethod, segment, segment_from_
 from .table import Plane, fit_plane, fit_table_plane
 
 __all__ = [
-    "DEPTH_MODES", "DepthMode", "Intrinsics", "MetricContour", "PerceptionError", "PerceptionWarning", "Plane",
+    "DEPTH_MODES", "DepthMode", "HeightMap", "Intrinsics", "MetricContour", "PerceptionError", "PerceptionWarning", "Plane",
     "SEGMENT_METHODS", "SegmentMethod", "Segmentation", "SegmentationError", "add_flat_parts", "approach_depth",
     "as_depth", "backproject", "colour_offset", "contour_to_metric", "denoised_depth", "fill_depth_holes",
-    "fit_plane", "fit_table_plane", "mask_contour", "object_footprint", "register_colour", "segment",
+    "fit_plane", "fit_table_plane", "height_map", "mask_contour", "object_footprint", "register_colour", "segment",
     "segment_depth", "segment_from_mask", "segment_rgb", "valid_depth",
 ]
