@@ -56,7 +56,7 @@ from .errors import HandError
 
 @dataclass(frozen=True)
 class Ray:
-    """Straight closing motion; ``closing_direction`` is normalised on creation.
+    """Straight closing motion; ``closing_direction`` is normalised on creation (kept when unit to 1e-15).
 
     Implements eq 3.18: the fingertip after travelling ``lam`` is ``start + lam * closing_direction``
     in the hand frame, placed at the pose (x_p, y_p, phi_p) by :func:`to_image`.
@@ -78,7 +78,9 @@ class Ray:
             norm = float(np.linalg.norm(c))
         if not np.isfinite(norm) or norm < tol.MIN_DIRECTION:
             raise HandError(f"closing_direction must be a non-zero 2-vector, got {self.closing_direction!r}")
-        object.__setattr__(self, "closing_direction", (float(c[0] / norm), float(c[1] / norm)))
+        if abs(norm - 1.0) > 1e-15:  # a unit vector is kept as given: normalising twice changes the last bit
+            c = c / norm
+        object.__setattr__(self, "closing_direction", (float(c[0]), float(c[1])))
 
 
 @dataclass(frozen=True)
@@ -487,8 +489,8 @@ def check_chain(finger: Finger, chain: FingerChain) -> None:
     open_, closed, path = chain_deviation(finger, chain)
     for label, value in (("open tip is", open_), ("closed tip is", closed)):
         if value > limit:
-            target = "start" if label.startswith("open") else "end of its travel"
-            raise HandError(f"{what} {label} {1000 * value:.2f} mm from the finger's {target} on the palm plane "
+            target = "the finger's start" if label.startswith("open") else "the end of the finger's travel"
+            raise HandError(f"{what} {label} {1000 * value:.2f} mm from {target} on the palm plane "
                             f"(at most {1000 * limit:g} mm)")
     if path > limit:
         kind = "ray" if isinstance(finger.trajectory, Ray) else "arc"
