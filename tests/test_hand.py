@@ -278,18 +278,16 @@ def test_a_chain_whose_path_leaves_the_ray_by_2_mm_is_refused():
     check_chain(*overshooting(0.0009))  # 0.9 mm: within the tolerance
 
 
-def test_path_check_catches_a_bulge_with_both_ends_on_the_ray():
-    # Open and closed tips exactly on the ray, the middle of the path 2 mm off it: the chain's
-    # plane is the ray's, but its knuckle sits 2 mm beside a finger whose ray is the chord
-    # through the chain's open and closed tips... in the palm plane a planar chain projects on a
-    # line, so a bulge needs an arc: an arc finger and the straight chord chain between its ends.
+def test_an_arc_finger_and_a_straight_chain_between_its_ends_differ_by_the_sagitta():
+    # A planar chain's tip projects onto a line, so against an arc it strays by the arc's sagitta
+    # even with both ends exactly on the arc: the path check (not the end checks) refuses it.
     arc = Arc(0.05, 0.05, 0.0)  # a circle of 5 cm: the tip moves from (0.05, 0) toward (0, 0.05)
     finger = Finger("thumb", start=(0.0, 0.0), trajectory=arc, travel=0.05 * 0.64, radius=0.0)
     end = finger.end
     d = end / np.linalg.norm(end)
     length = float(np.linalg.norm(end))
-    # A chain sliding its tip from start to end in a straight line: hanging straight, knuckle above
-    # the middle of the chord, links equal, angles symmetric about the vertical.
+    # A chain whose tip slides along the chord: knuckle above the chord's middle, links equal, the
+    # proximal link swinging symmetrically about the vertical.
     l = 0.05
     half = length / 2
     q = math.asin(half / (2 * l))

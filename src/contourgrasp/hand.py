@@ -391,16 +391,37 @@ def polygon_area(points) -> float:
 
 
 def chain_angles(chain: FingerChain, s) -> np.ndarray:
-    """(m, 2) float: joint angles (q1, q2) at closing progress ``s`` (m,), the linear synergy."""
+    """Joint angles along the closing synergy ``q(s) = open_angles + s * (closed_angles - open_angles)``.
+
+    Parameters
+    ----------
+    chain : FingerChain
+    s : float or (m,) float
+        Closing progress, 0 open, 1 fully closed.
+
+    Returns
+    -------
+    (m, 2) float
+        (q1, q2) per progress, rad.
+    """
     s = np.atleast_1d(np.asarray(s, dtype=float))[:, None]
     q_open, q_closed = np.asarray(chain.open_angles), np.asarray(chain.closed_angles)
     return q_open + s * (q_closed - q_open)
 
 
 def chain_joints(chain: FingerChain, s) -> np.ndarray:
-    """(m, 3, 3) float: knuckle, middle joint and tip (x, y, z) at closing progress ``s`` (m,).
+    """Forward kinematics of :class:`FingerChain` in the 3-D hand frame (z down from the palm).
 
-    Forward kinematics of :class:`FingerChain` in the 3-D hand frame (z down from the palm).
+    Parameters
+    ----------
+    chain : FingerChain
+    s : float or (m,) float
+        Closing progress in [0, 1].
+
+    Returns
+    -------
+    (m, 3, 3) float
+        Per progress, the knuckle, the middle joint and the tip, each (x, y, z), m.
     """
     q = chain_angles(chain, s)
     a = np.cumsum(q, axis=1)  # absolute angles from +z: (m, 2)
@@ -414,16 +435,37 @@ def chain_joints(chain: FingerChain, s) -> np.ndarray:
 
 
 def chain_tip(chain: FingerChain, s) -> np.ndarray:
-    """(m, 3) float: the fingertip (x, y, z) at closing progress ``s`` (m,)."""
+    """The fingertip (the centre of the distal link's end cap) at closing progress ``s``.
+
+    Parameters
+    ----------
+    chain : FingerChain
+    s : float or (m,) float
+
+    Returns
+    -------
+    (m, 3) float
+        (x, y, z) in the 3-D hand frame, m.
+    """
     return chain_joints(chain, s)[:, 2]
 
 
 def chain_capsules(chain: FingerChain, s) -> np.ndarray:
-    """(m, 3, 2, 3) float: end points of the finger's capsules at closing progress ``s`` (m,).
+    """The finger's capsules at closing progress ``s``, each of radius ``chain.radius``.
 
-    Capsules, each of radius ``chain.radius``: the post from the palm's underside straight down to
-    the knuckle (of zero length when ``knuckle_depth`` is 0), the proximal link (knuckle to middle
-    joint) and the distal link (middle joint to tip).
+    Capsules: the post from the palm's underside straight down to the knuckle (of zero length
+    when ``knuckle_depth`` is 0), the proximal link (knuckle to middle joint) and the distal link
+    (middle joint to tip), as the simulated hand builds them.
+
+    Parameters
+    ----------
+    chain : FingerChain
+    s : float or (m,) float
+
+    Returns
+    -------
+    (m, 3, 2, 3) float
+        Per progress, per capsule (post, proximal, distal), its two end points (x, y, z), m.
     """
     joints = chain_joints(chain, s)
     top = joints[:, 0].copy()
@@ -443,7 +485,18 @@ def trajectory_polyline(finger: Finger) -> np.ndarray:
 
 
 def polyline_distance(points, polyline) -> np.ndarray:
-    """(m,) float: distance of each point (m, 2) to the polyline (k, 2), k >= 2."""
+    """Distance of each point to a polyline.
+
+    Parameters
+    ----------
+    points : (m, 2) float
+    polyline : (k, 2) float
+        k >= 2 vertices.
+
+    Returns
+    -------
+    (m,) float
+    """
     p, v = np.asarray(points, dtype=float), np.asarray(polyline, dtype=float)
     a, d = v[:-1], np.diff(v, axis=0)  # (k-1, 2)
     rel = p[:, None, :] - a[None]  # (m, k-1, 2)
