@@ -290,6 +290,21 @@ WRENCH_BATCH_ELEMENTS = 2_000_000
 #: pose and finger on the grid), and no hand the planner is meant for has more fingertips.
 MAX_FINGERS = 10
 
+#: A finger's 3-D chain must agree with its 2-D trajectory to this distance (m): its open tip,
+#: projected on the palm plane, within it of ``start``, its closed tip within it of the trajectory's
+#: end, and the projected tip path within it of the trajectory all along (hand.check_chain).
+CHAIN_TRAJECTORY = 1e-3
+
+#: Closing progresses s in [0, 1] at which hand.check_chain compares a chain's tip with its 2-D path.
+CHAIN_SAMPLES = 201
+
+#: Vertices of the polyline an arc trajectory is compared against by hand.check_chain (its chords
+#: are within a few micrometres of the arc for the presets' sizes).
+CHAIN_ARC_VERTICES = 1025
+
+#: Largest |joint angle| of a finger chain (rad): a link turned more than half a turn from the
+#: approach axis is a sign or unit slip (degrees for radians).
+MAX_JOINT_ANGLE = 3.141592653589793
 
 # --- depth images (camera files and ROS messages) ---
 

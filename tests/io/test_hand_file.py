@@ -95,6 +95,7 @@ def test_hand_to_toml_round_trips(name):
         assert (g.name, g.start, g.travel, g.virtual_start, g.alpha, g.beta, g.required) == (
             f.name, f.start, f.travel, f.virtual_start, f.alpha, f.beta, f.required)
         np.testing.assert_allclose(g.points([0.0, 0.01]), f.points([0.0, 0.01]), atol=1e-15)
+    assert (again.chains, again.palm) == (hand.chains, hand.palm)  # the 3-D body exactly (None for a 2-D hand)
 
 
 def test_hand_to_toml_escapes_names():
@@ -166,3 +167,96 @@ def test_fuzz_load_hand_on_random_bytes_gives_a_hand_or_a_hand_file_error(tmp_pa
         assert str(err).startswith(str(path)) and "\n" not in str(err)
         return
     assert np.all(np.isfinite(hand.starts))
+
+
+# --- the 3-D body: [fingers.chain] and [palm] ---
+
+PINCH_3D = GOOD.replace("""beta = 1000.0
+[[fingers]]""", """beta = 1000.0
+radius = 0.008
+[fingers.chain]
+knuckle = [-0.06, 0.0]
+knuckle_depth = 0.01
+links = [0.05, 0.05]
+open_angles = [0.0, 0.0]
+closed_angles = [0.0, 1.5707963267948966]
+[[fingers]]""") + """radius = 0.008
+[fingers.chain]
+knuckle = [0.06, 0.0]
+knuckle_depth = 0.01
+links = [0.05, 0.05]
+open_angles = [0.0, 0.0]
+closed_angles = [0.0, 1.5707963267948966]
+[palm]
+outline = [[-0.08, -0.02], [0.08, -0.02], [0.08, 0.02], [-0.08, 0.02]]
+thickness = 0.02
+"""
+# Each finger of GOOD with a body: the proximal link straight down below its open tip, the distal
+# swinging from straight down to horizontal (pi / 2), which brings the tip the travel, 0.05 m, ahead.
+
+
+def test_a_3d_hand_file_loads_its_chains_and_palm(tmp_path):
+    path = tmp_path / "pinch3d.toml"
+    path.write_text(PINCH_3D)
+    hand = load_hand(path)
+    assert hand.is_3d and [c.knuckle for c in hand.chains] == [(-0.06, 0.0), (0.06, 0.0)]
+    assert hand.chains[0].direction == (1.0, 0.0) and hand.chains[1].direction == (-1.0, 0.0)  # the rays'
+    assert [c.radius for c in hand.chains] == [0.008, 0.008]  # the finger's radius
+    assert hand.palm.thickness == 0.02 and len(hand.palm.outline) == 4
+    assert parse_hand(hand_to_toml(hand)) == hand
+
+
+@pytest.mark.parametrize(
+    "old, new, message",
+    [
+        ("links = [0.05, 0.05]", "links = [0.05, -0.05]", r"fingers\[0\] \(left\)\.chain\.links\[1\]: Input should be greater than 0"),
+        ("knuckle_depth = 0.01", "knuckle_depth = -0.01", r"fingers\[0\] \(left\)\.chain\.knuckle_depth"),
+        ("knuckle_depth = 0.01", "knuckle_depth = 0.01\nlength = 3", r"fingers\[0\] \(left\)\.chain\.length: unknown key"),
+        ("open_angles = [0.0, 0.0]", "open_angles = [0.0]", r"fingers\[0\] \(left\)\.chain\.open_angles: List should have at least 2 items"),
+        ("thickness = 0.02", "thickness = 0.0", r"palm\.thickness: Input should be greater than 0"),
+        ("outline = [[-0.08, -0.02], [0.08, -0.02], [0.08, 0.02], [-0.08, 0.02]]", "outline = [[0.0, 0.0], [0.1, 0.0]]",
+         r"palm\.outline: List should have at least 3 items"),
+        ("knuckle = [-0.06, 0.0]", "knuckle = [-0.062, 0.0]",
+         r"fingers\[0\] \(left\)\.chain: finger 'left': 3-D chain open tip is 2\.00 mm from the finger's start"),
+        ("knuckle = [0.06, 0.0]", "knuckle = [0.06, 0.002]",
+         r"fingers\[1\] \(right\)\.chain: finger 'right': 3-D chain open tip is 2\.00 mm"),
+    ],
+)
+def test_3d_hand_file_errors_name_the_file_and_the_field(tmp_path, old, new, message):
+    assert old in PINCH_3D
+    path = tmp_path / "bad.toml"
+    path.write_text(PINCH_3D.replace(old, new, 1))
+    with pytest.raises(HandFileError, match=re.escape(str(path)) + ": " + message):
+        load_hand(path)
+
+
+def test_a_3d_hand_needs_every_chain_and_the_palm():
+    with pytest.raises(HandFileError, match=r"hand: a 3-D hand needs .* missing: \[palm\]"):
+        parse_hand(PINCH_3D.split("[palm]")[0])
+    right_chain = PINCH_3D.index("[fingers.chain]\nknuckle = [0.06")
+    text = PINCH_3D[:right_chain] + PINCH_3D[PINCH_3D.index("[palm]"):]
+    assert text.count("[fingers.chain]") == 1
+    with pytest.raises(HandFileError, match=r"missing: \[fingers\.chain\] of right"):
+        parse_hand(text)
+
+
+def test_an_arc_finger_chain_needs_its_direction():
+    hand = load_hand("five-finger-curved-thumb")
+    text = hand_to_toml(hand).replace("radius = 0.011\n", "radius = 0.011\n[fingers.chain]\nknuckle = [-0.1, 0.1]\n"
+                                      "knuckle_depth = 0.0\nlinks = [0.06, 0.05]\nopen_angles = [0.0, 0.0]\n"
+                                      "closed_angles = [0.5, 0.5]\n", 1)
+    with pytest.raises(HandFileError, match=r"fingers\[0\] \(thumb\): chain.direction is required for a finger on an arc"):
+        parse_hand(text)
+
+
+def test_a_2d_hand_file_plans_with_a_note(tmp_path):
+    path = tmp_path / "pinch.toml"
+    path.write_text(GOOD)
+    plan = cg.synthesize(cg.example_contour("ellipse") * 0.8, path, yaw_step=math.radians(10))
+    assert len(plan.notes) == 1 and "no 3-D geometry" in plan.notes[0] and "'pinch'" in plan.notes[0]
+    from contourgrasp.io.plan_file import plan_to_dict
+    assert plan_to_dict(plan)["notes"] == list(plan.notes)
+    three_d = tmp_path / "pinch3d.toml"
+    three_d.write_text(PINCH_3D)
+    plan = cg.synthesize(cg.example_contour("ellipse") * 0.8, three_d, yaw_step=math.radians(10))
+    assert plan.notes == () and plan_to_dict(plan)["notes"] == []

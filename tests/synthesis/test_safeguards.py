@@ -58,7 +58,9 @@ def test_a_head_on_approach_is_clear_and_the_check_follows_the_pose():
 
 def test_zero_radius_and_clearance_change_nothing():
     contour, hand = cg.example_contour("case"), cg.load_hand("three-finger")
-    thin = dataclasses.replace(hand, fingers=tuple(dataclasses.replace(f, radius=0.0) for f in hand.fingers))
+    # 2-D fingertips of radius 0 (the 3-D body, whose links have the fingers' radius, dropped)
+    thin = dataclasses.replace(hand, fingers=tuple(dataclasses.replace(f, radius=0.0) for f in hand.fingers),
+                               chains=None, palm=None)
     plain = cg.synthesize(contour, thin, **FAST)
     checked = cg.synthesize(contour, thin, finger_thickness=True, **FAST)
     np.testing.assert_array_equal(plain.pose, checked.pose)

@@ -20,7 +20,26 @@ Schema (all lengths in meters, angles in radians)::
     beta = 10000.0                   # ratio gain, optional, default 0
     required = true                  # optional, default false
     radius = 0.011                   # optional, >= 0, default 0: half the finger's
-                                     # width (finger-thickness check of the planner)
+                                     # width (finger-thickness check of the planner;
+                                     # the links' radius of its chain)
+
+    [fingers.chain]                  # optional: the finger's body (3-D hand frame, z down)
+    knuckle = [-0.088, 0.094]        # (x, y) of the proximal joint
+    knuckle_depth = 0.0              # >= 0, below the palm's underside
+    direction = [0.994, 0.106]       # optional: the chain's plane; default closing_direction
+                                     # (required for an arc finger)
+    links = [0.0668, 0.0547]         # proximal, distal > 0
+    open_angles = [-0.43, 0.0]       # (q1, q2) of the open finger, rad
+    closed_angles = [0.103, 0.533]   # and of the fully closed one (linear synergy between)
+
+    [palm]                           # with the chains: every finger has one, or none does
+    outline = [[x, y], ...]          # >= 3 vertices, the palm's underside
+    thickness = 0.025                # > 0
+
+A 3-D part inconsistent with the 2-D one (the chain's open tip more than 1 mm from ``start``
+on the palm plane, its closed tip more than 1 mm from the end of the travel, or its tip path
+more than 1 mm off the ray or arc: :func:`contourgrasp.hand.check_chain`) is refused naming
+the finger.
 
 Lengths are at most ``tolerances.MAX_HAND_SIZE`` (2 m) in magnitude, ``|phi_off|`` at most
 ``tolerances.MAX_ARC_ANGLE``, gains (alpha, beta, miss_penalty) at most ``tolerances.MAX_GAIN``
@@ -38,7 +57,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from .. import tolerances as tol
 from ..errors import HandError, HandFileError
-from ..hand import Arc, Finger, Hand, Ray
+from ..hand import Arc, Finger, FingerChain, Hand, Palm, Ray, check_chain
 from . import _toml_files
 
 _PRESET_DIR = "data/hands"
@@ -66,6 +85,31 @@ class _ArcSchema(_Strict):
     phi_off: Angle
 
 
+Angles2 = Annotated[list[Annotated[float, Field(ge=-tol.MAX_JOINT_ANGLE, le=tol.MAX_JOINT_ANGLE,
+                                                 allow_inf_nan=False)]], Field(min_length=2, max_length=2)]
+Links2 = Annotated[list[Length], Field(min_length=2, max_length=2)]
+
+
+class _ChainSchema(_Strict):
+    knuckle: Point2
+    knuckle_depth: Radius
+    direction: Vector2 | None = None
+    links: Links2
+    open_angles: Angles2
+    closed_angles: Angles2
+
+    @model_validator(mode="after")
+    def _direction(self):
+        if self.direction is not None and max(map(abs, self.direction)) == 0:
+            raise ValueError("direction has zero length")
+        return self
+
+
+class _PalmSchema(_Strict):
+    outline: Annotated[list[Point2], Field(min_length=3, max_length=1000)]
+    thickness: Length
+
+
 class _FingerSchema(_Strict):
     name: str = Field(min_length=1)
     start: Point2
@@ -77,6 +121,7 @@ class _FingerSchema(_Strict):
     beta: Gain = 0.0
     required: bool = False
     radius: Radius = 0.0
+    chain: _ChainSchema | None = None
 
     @model_validator(mode="after")
     def _one_trajectory(self):
@@ -84,6 +129,8 @@ class _FingerSchema(_Strict):
             raise ValueError("give exactly one of closing_direction (a ray) or arc")
         if self.closing_direction is not None and max(map(abs, self.closing_direction)) == 0:
             raise ValueError("closing_direction has zero length")
+        if self.chain is not None and self.chain.direction is None and self.arc is not None:
+            raise ValueError("chain.direction is required for a finger on an arc")
         return self
 
 
@@ -93,6 +140,7 @@ class _HandSchema(_Strict):
     min_touching: int = Field(ge=1)
     miss_penalty: Gain | None = None
     fingers: list[_FingerSchema] = Field(min_length=1, max_length=tol.MAX_FINGERS)
+    palm: _PalmSchema | None = None
 
     @model_validator(mode="after")
     def _consistent(self):
@@ -101,6 +149,10 @@ class _HandSchema(_Strict):
         names = [f.name for f in self.fingers]
         if len(set(names)) != len(names):
             raise ValueError(f"finger names must be unique, got {names}")
+        without = [f.name for f in self.fingers if f.chain is None]
+        if (self.palm is not None or len(without) < len(self.fingers)) and (without or self.palm is None):
+            missing = f"[fingers.chain] of {', '.join(without)}" if without else "[palm]"
+            raise ValueError(f"a 3-D hand needs a [fingers.chain] for every finger and a [palm]; missing: {missing}")
         return self
 
 
@@ -131,15 +183,42 @@ def parse_hand(text: str, *, source: str = "<string>") -> Hand:
     except ValidationError as err:
         raise HandFileError(f"{source}: {_describe(err, raw)}") from None
     try:
+        fingers = tuple(_finger(f) for f in schema.fingers)
+    except HandError as err:
+        raise HandFileError(f"{source}: {err}") from None
+    chains = palm = None
+    if schema.palm is not None:
+        chains = tuple(_chain(source, i, f, s) for i, (f, s) in enumerate(zip(fingers, schema.fingers, strict=True)))
+        try:
+            palm = Palm(outline=tuple(map(tuple, schema.palm.outline)), thickness=schema.palm.thickness)
+        except HandError as err:
+            raise HandFileError(f"{source}: palm: {err}") from None
+    try:
         return Hand(
             name=schema.name,
-            fingers=tuple(_finger(f) for f in schema.fingers),
+            fingers=fingers,
             min_touching=schema.min_touching,
             miss_penalty=_miss_penalty(schema),
             description=schema.description,
+            chains=chains,
+            palm=palm,
         )
     except HandError as err:
         raise HandFileError(f"{source}: {err}") from None
+
+
+def _chain(source: str, index: int, finger: Finger, f: _FingerSchema) -> FingerChain:
+    """The chain of ``finger``, checked against its trajectory; errors name ``fingers[index] (name).chain``."""
+    c = f.chain
+    direction = c.direction if c.direction is not None else finger.trajectory.closing_direction
+    try:
+        chain = FingerChain(knuckle=tuple(c.knuckle), knuckle_depth=c.knuckle_depth, direction=tuple(direction),
+                            links=tuple(c.links), radius=finger.radius, open_angles=tuple(c.open_angles),
+                            closed_angles=tuple(c.closed_angles))
+        check_chain(finger, chain)
+    except HandError as err:
+        raise HandFileError(f"{source}: fingers[{index}] ({finger.name}).chain: {err}") from None
+    return chain
 
 
 def _miss_penalty(schema: _HandSchema) -> float:
@@ -206,7 +285,27 @@ def hand_to_toml(hand: Hand, *, comment: str = "") -> str:
         lines += [f"travel = {_float(f.travel)}", f"virtual_start = {_float(f.virtual_start)}",
                   f"alpha = {_float(f.alpha)}", f"beta = {_float(f.beta)}", f"required = {str(f.required).lower()}",
                   f"radius = {_float(f.radius)}"]
+        if hand.chains is not None:
+            lines += chain_toml(hand.chains[hand.fingers.index(f)], f)
+    if hand.palm is not None:
+        lines += palm_toml(hand.palm)
     return "\n".join(lines) + "\n"
+
+
+def chain_toml(chain: FingerChain, finger: Finger) -> list[str]:
+    """The lines of the ``[fingers.chain]`` table of ``chain`` (its direction only when not the ray's)."""
+    lines = ["", "[fingers.chain]", f"knuckle = {_floats(chain.knuckle)}",
+             f"knuckle_depth = {_float(chain.knuckle_depth)}"]
+    if not isinstance(finger.trajectory, Ray) or tuple(chain.direction) != finger.trajectory.closing_direction:
+        lines.append(f"direction = {_floats(chain.direction)}")
+    return lines + [f"links = {_floats(chain.links)}", f"open_angles = {_floats(chain.open_angles)}",
+                    f"closed_angles = {_floats(chain.closed_angles)}"]
+
+
+def palm_toml(palm: Palm) -> list[str]:
+    """The lines of the ``[palm]`` table."""
+    outline = ", ".join(_floats(p) for p in palm.outline)
+    return ["", "[palm]", f"outline = [{outline}]", f"thickness = {_float(palm.thickness)}"]
 
 
 def _string(text: str) -> str:

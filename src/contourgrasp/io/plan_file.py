@@ -78,6 +78,7 @@ def plan_to_dict(plan: GraspPlan) -> dict:
             "grid_pose": _pose(plan.refinement.grid_pose), "grid_cost": plan.refinement.grid_cost,
             "cost": plan.refinement.cost, "gain": plan.refinement.gain},
         "timing_ms": dict(plan.timing_ms),
+        "notes": list(plan.notes),
     }
 
 

@@ -21,7 +21,7 @@ Example::
     record.success, record.cause, record.fingers_in_contact
 """
 
-from .hand_model import TIMINGS, FingerTiming, HandDesign, HandModel, build_hand
+from .hand_model import TIMINGS, ChainRule, FingerTiming, HandDesign, HandModel, build_hand, derive_body
 from .measure import fingertip_path_error, fingertip_paths
 from .objects import THESIS_OBJECTS, ObjectSpec, Part, mesh_object, object_spec
 from .render import DepthNoise, object_truth, render, render_view, tilted_view
@@ -31,9 +31,9 @@ from .trial import (DROPPED, FAILURE_CAUSES, NO_PLAN, PUSHED, SLIPPED, STRUCK, E
                     execute_grasp, hand_pose_from_matrix, pose_matrix, run_trial, scripted_grasp)
 
 __all__ = [
-    "Camera", "DROPPED", "DepthNoise", "Execution", "FAILURE_CAUSES", "FingerTiming", "GraspOutcome", "HandDesign",
+    "Camera", "ChainRule", "DROPPED", "DepthNoise", "Execution", "FAILURE_CAUSES", "FingerTiming", "GraspOutcome", "HandDesign",
     "HandModel", "Intrinsics", "NO_PLAN", "ObjectSpec", "PUSHED", "Part", "Placement", "SLIPPED", "SR300", "STRUCK",
-    "Scene", "THESIS_OBJECTS", "TIMINGS", "TrialRecord", "Workspace", "build_hand", "build_scene", "execute_grasp",
+    "Scene", "THESIS_OBJECTS", "TIMINGS", "TrialRecord", "Workspace", "build_hand", "build_scene", "derive_body", "execute_grasp",
     "fingertip_path_error", "fingertip_paths", "hand_pose_from_matrix", "mesh_object", "object_spec", "object_truth",
     "pose_matrix", "render", "render_view", "run_trial", "scripted_grasp", "tilted_view",
 ]

@@ -6,28 +6,32 @@ closing, and all of them then squeeze with the tendon's force. This module
 builds that idea as MuJoCo XML from a :class:`~contourgrasp.hand.Hand` whose
 fingers close on rays.
 
-Geometry (our reading)
-----------------------
+Geometry (one truth: the hand file)
+-----------------------------------
 The preset's 2-D hand frame (origin at the reference point) is the plane of the
 palm's underside, parallel to the image plane; the 3-D hand frame adds z along
-the camera's z (down, toward the table). Every finger is a planar chain of two
-links (proximal, distal) hanging from a knuckle; both hinges are perpendicular
-to the vertical plane that holds the finger's open tip, ``start``, and its
-closing direction. So the fingertip moves in that plane only and its projection
-onto the image plane stays on the preset's ray ``start + lam * closing_direction``
-whatever the joint angles. The fingertip is the centre of the distal link's end
-cap. In free space both joints flex together (distal = ``distal_ratio`` x
-proximal); the joint ranges are solved so that the fully closed finger ends
-exactly ``travel`` along the ray.
+the camera's z (down, toward the table). The hand file's 3-D part
+(:class:`~contourgrasp.hand.FingerChain` per finger and
+:class:`~contourgrasp.hand.Palm`) is what is built: every finger a planar chain
+of two capsules (proximal, distal) hanging from its knuckle, a post from the
+palm down to the knuckle when it hangs below it, both hinges perpendicular to
+the chain's vertical plane, the open pose's joint angles and the closed pose's
+as joint ranges; the palm a box (its outline must be an axis-aligned rectangle).
+The fingertip is the centre of the distal link's end cap.
 
-The open finger leans outward by a tilt chosen so that the tip's height varies
+A hand without chains (a 2-D hand file) is given chains first by
+:func:`derive_body` with a :class:`ChainRule` -- the rule that produced the
+presets' chains (``tools/derive_hand_chains.py``): fingers ``min_length`` long
+or ``length_per_travel`` times their travel, whichever is longer; both joints
+flexing together in free space (distal = ``distal_ratio`` x proximal), their
+ranges solved so that the fully closed finger ends exactly ``travel`` along the
+ray; the open finger leaning outward by the tilt that makes the tip's height vary
 least over its closing (it swings through the vertical, like a pendulum through
-its lowest point): a tip that rose as it closed -- 5 cm for a thumb hanging
-straight down -- would pass over flat objects such as the stones. What is left
-is a few millimetres for a finger, about a centimetre for the thumb. Knuckles
-hang at depths that bring every fingertip's lowest point to the same depth,
-``tip_depth`` below the palm. Fingers are ``min_length`` long or
-``length_per_travel`` times their travel, whichever is longer.
+its lowest point: a tip that rose as it closed -- 5 cm for a thumb hanging
+straight down -- would pass over flat objects such as the stones); knuckles at
+depths that bring every fingertip's lowest point to the same depth; the palm the
+knuckles' bounding box grown by ``palm_margin``. Radii are the fingers'
+``radius`` of the hand file.
 
 Actuation
 ---------
@@ -55,8 +59,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
-from ..errors import SimulationError
-from ..hand import Hand, Ray
+from ..errors import HandError, SimulationError
+from ..hand import FingerChain, Hand, Palm, Ray, chain_tip
 
 #: Contact bits (contype/conaffinity): the table collides with hand and object,
 #: the hand and the object with the table only; hand-object contacts are explicit pairs.
@@ -101,21 +105,14 @@ TIMINGS = {
 class HandDesign:
     """Physical parameters of the simulated hand (SI units).
 
-    Defaults: fingers about human size (a qbHand finger is ~0.1 m long, ~18 mm
-    wide), a 0.5 kg hand, a grip of roughly 10 N per finger and 20-30 N at the
-    thumb (the qbHand's datasheet gives ~60 N of grasp force in total).
+    The hand's geometry (links, radii, knuckles, palm) is not here: it is the hand file's
+    (:class:`~contourgrasp.hand.FingerChain`, :class:`~contourgrasp.hand.Palm`). Defaults: a
+    0.5 kg hand, a grip of roughly 10 N per finger and 20-30 N at the thumb (the qbHand's
+    datasheet gives ~60 N of grasp force in total).
     """
 
-    min_length: float = 0.10
-    length_per_travel: float = 1.35
-    proximal_fraction: float = 0.55
-    distal_ratio: float = 1.0
-    finger_radius: float = 0.009
-    thumb_radius: float = 0.011
     finger_density: float = 900.0
     palm_mass: float = 0.40
-    palm_thickness: float = 0.025
-    palm_margin: float = 0.02
     max_tendon_force: float = 100.0
     moment_arms: tuple[float, float] = (0.008, 0.005)
     thumb_strength: float = 2.5
@@ -128,50 +125,95 @@ class HandDesign:
 
 
 @dataclass(frozen=True)
+class ChainRule:
+    """How :func:`derive_body` gives a 2-D hand its bodies (the presets' chains came from it).
+
+    Defaults: fingers about human size (a qbHand finger is ~0.1 m long, ~18 mm wide).
+
+    Attributes
+    ----------
+    min_length, length_per_travel : float
+        A finger is ``max(min_length, length_per_travel * travel)`` long, m.
+    proximal_fraction : float
+        The proximal link's share of that length.
+    distal_ratio : float
+        Distal joint range / proximal joint range (the synergy's coupling).
+    palm_margin : float
+        The palm is the knuckles' bounding box grown by this on every side, m.
+    palm_thickness : float
+        m.
+    """
+
+    min_length: float = 0.10
+    length_per_travel: float = 1.35
+    proximal_fraction: float = 0.55
+    distal_ratio: float = 1.0
+    palm_margin: float = 0.02
+    palm_thickness: float = 0.025
+
+
+@dataclass(frozen=True)
 class FingerModel:
-    """One simulated finger: its links and joint ranges (hand frame, z down).
+    """One simulated finger: its chain (from the hand file) and its actuation.
 
     Attributes
     ----------
     name : str
     start : (2,) float
         Open fingertip, hand frame (the preset's start).
-    direction : (2,) float
-        Unit closing direction.
     travel : float
-    lengths : (2,) float
-        Proximal and distal link lengths, m.
-    tilt : float
-        Outward lean of the open finger from the vertical, rad.
-    knuckle_depth : float
-        Depth of the knuckle below the palm's underside, m.
-    q_max : (2,) float
-        Joint ranges [0, q_max] from the open pose, rad.
-    radius : float
+    chain : FingerChain
+        Knuckle, links, radius, open and closed joint angles (hand frame, z down).
     moment_arms : (2,) float
     timing : FingerTiming
     """
 
     name: str
     start: tuple[float, float]
-    direction: tuple[float, float]
     travel: float
-    lengths: tuple[float, float]
-    tilt: float
-    knuckle_depth: float
-    q_max: tuple[float, float]
-    radius: float
+    chain: FingerChain
     moment_arms: tuple[float, float]
     timing: FingerTiming
 
     @property
+    def direction(self) -> tuple[float, float]:
+        """(2,) float: unit horizontal direction of the chain's plane (the closing direction)."""
+        return self.chain.direction
+
+    @property
+    def lengths(self) -> tuple[float, float]:
+        """Proximal and distal link lengths, m."""
+        return self.chain.links
+
+    @property
+    def radius(self) -> float:
+        return self.chain.radius
+
+    @property
+    def tilt(self) -> float:
+        """Outward lean of the open proximal link from the vertical, rad (``-open_angles[0]``)."""
+        return -self.chain.open_angles[0]
+
+    @property
     def knuckle(self) -> np.ndarray:
-        """(2,) float: the knuckle's position in the hand frame (inward of the open tip by the lean)."""
-        return np.asarray(self.start) + sum(self.lengths) * np.sin(self.tilt) * np.asarray(self.direction)
+        """(2,) float: the knuckle's position in the hand frame."""
+        return np.asarray(self.chain.knuckle)
+
+    @property
+    def knuckle_depth(self) -> float:
+        """Depth of the knuckle below the palm's underside, m."""
+        return self.chain.knuckle_depth
+
+    @property
+    def q_max(self) -> tuple[float, float]:
+        """Joint ranges [0, q_max] from the open pose, rad."""
+        (o1, o2), (c1, c2) = self.chain.open_angles, self.chain.closed_angles
+        return c1 - o1, c2 - o2
 
     def tip(self, u) -> tuple[np.ndarray, np.ndarray]:
         """Free-space fingertip at closing fraction ``u`` in [0, 1]: advance along the ray, depth below the knuckle."""
-        return _tip(*self.lengths, self.tilt, self.q_max[0], self.q_max[1] / self.q_max[0], np.asarray(u))
+        tip = chain_tip(self.chain, u)
+        return (tip[:, :2] - self.start) @ np.asarray(self.direction), tip[:, 2] - self.knuckle_depth
 
 
 @dataclass(frozen=True)
@@ -181,7 +223,7 @@ class HandModel:
     Attributes
     ----------
     hand : Hand
-        The 2-D preset it realises.
+        The 3-D hand it realises (the preset's, or its :func:`derive_body` for a 2-D one).
     design : HandDesign
     fingers : tuple of FingerModel
     tip_depth : float
@@ -210,7 +252,7 @@ class HandModel:
         """The ``<body>`` of the hand on its x, y, z, yaw base, for the world body."""
         d = self.design
         (x0, y0), (x1, y1) = self.palm_box
-        t = d.palm_thickness
+        t = self.hand.palm.thickness
         contact = f'contype="{HAND_BIT}" conaffinity="{TABLE_BIT}" group="2"'
         lines = [
             '<body name="hand_base" gravcomp="1">',
@@ -249,7 +291,8 @@ class HandModel:
             f'  <joint name="{f.name}_1" {self._joint_attrs(f, 0, axis)}/>',
             f'  <geom name="{f.name}_proximal" type="capsule" fromto="0 0 0 0 0 {_f(l1)}" size="{_f(f.radius)}" '
             f'{density} {rgba} {contact}/>',
-            f'  <body name="{f.name}_distal" pos="0 0 {_f(l1)}" gravcomp="1">',
+            f'  <body name="{f.name}_distal" pos="0 0 {_f(l1)}"{_bend(f.chain.open_angles[1], dx, dy)} '
+            'gravcomp="1">',
             f'    <joint name="{f.name}_2" {self._joint_attrs(f, 1, axis)}/>',
             f'    <geom name="{f.name}_distal" type="capsule" fromto="0 0 0 0 0 {_f(l2)}" size="{_f(f.radius)}" '
             f'{density} {rgba} {contact}/>',
@@ -288,51 +331,99 @@ class HandModel:
 
 
 def build_hand(hand: Hand, *, design: HandDesign = HandDesign(), timing: str = "thesis") -> HandModel:
-    """The simulated counterpart of a 2-D hand whose fingers close on rays.
+    """The simulated hand of a hand whose fingers close on rays: its file's chains and palm.
+
+    A 2-D hand (no chains) gets them from :func:`derive_body` first.
 
     Raises
     ------
     SimulationError
-        A finger closes on an arc, an unknown ``timing``, or a travel no finger
-        of the design can reach.
+        A finger closes on an arc, an unknown ``timing``, a travel no finger of the
+        :class:`ChainRule` can reach, a finger of radius 0, a joint whose closed angle is not
+        beyond its open one, or a palm that is not an axis-aligned rectangle.
     """
     if timing not in TIMINGS:
         raise SimulationError(f"unknown finger timing {timing!r}; choose one of {', '.join(TIMINGS)}")
     schedule = TIMINGS[timing]
-    fingers = []
     for finger in hand.fingers:
         if not isinstance(finger.trajectory, Ray):
             raise SimulationError(f"hand {hand.name!r}: finger {finger.name!r} closes on an arc; "
                              "the simulated hand realises straight (ray) trajectories only")
-        fingers.append(_finger_model(finger, design, schedule.get(finger.name, schedule["default"])))
-    reach = [float(f.tip(np.linspace(0.0, 1.0, 201))[1].max()) for f in fingers]
-    tip_depth = max(reach)
-    fingers = [replace(f, knuckle_depth=tip_depth - r) for f, r in zip(fingers, reach, strict=True)]
-    knuckles = np.array([f.knuckle for f in fingers])
-    margin = design.palm_margin
-    palm_box = (tuple(knuckles.min(axis=0) - margin), tuple(knuckles.max(axis=0) + margin))
-    return HandModel(hand=hand, design=design, fingers=tuple(fingers), tip_depth=tip_depth, palm_box=palm_box)
+    if not hand.is_3d:
+        hand = derive_body(hand)
+    fingers = []
+    for finger, chain in zip(hand.fingers, hand.chains, strict=True):
+        what = f"hand {hand.name!r}: finger {finger.name!r}"
+        if chain.radius <= 0:
+            raise SimulationError(f"{what} has radius 0: the simulated finger needs a thickness")
+        if not all(c > o for o, c in zip(chain.open_angles, chain.closed_angles, strict=True)):
+            raise SimulationError(f"{what}: every closed joint angle must exceed the open one (hinges flex one way)")
+        strength = design.thumb_strength if finger.required else 1.0
+        fingers.append(FingerModel(name=finger.name, start=finger.start, travel=finger.travel, chain=chain,
+                                   moment_arms=(strength * design.moment_arms[0], strength * design.moment_arms[1]),
+                                   timing=schedule.get(finger.name, schedule["default"])))
+    tip_depth = max(float(chain_tip(c, np.linspace(0.0, 1.0, REACH_SAMPLES))[:, 2].max()) for c in hand.chains)
+    return HandModel(hand=hand, design=design, fingers=tuple(fingers), tip_depth=tip_depth,
+                     palm_box=_palm_box(hand))
 
 
-def _finger_model(finger, design: HandDesign, timing: FingerTiming) -> FingerModel:
-    length = max(design.min_length, design.length_per_travel * finger.travel)
-    l1, l2 = design.proximal_fraction * length, (1 - design.proximal_fraction) * length
-    tilt, q1 = _flattest_swing(l1, l2, design.distal_ratio, finger.travel, finger.name)
-    strength = design.thumb_strength if finger.required else 1.0
-    radius = design.thumb_radius if finger.required else design.finger_radius
-    return FingerModel(
-        name=finger.name,
-        start=finger.start,
-        direction=finger.trajectory.closing_direction,
-        travel=finger.travel,
-        lengths=(l1, l2),
-        tilt=tilt,
-        knuckle_depth=0.0,
-        q_max=(q1, design.distal_ratio * q1),
-        radius=radius,
-        moment_arms=(strength * design.moment_arms[0], strength * design.moment_arms[1]),
-        timing=timing,
-    )
+#: Closing progresses at which the fingertips' lowest point (the hand's tip depth) is looked for.
+REACH_SAMPLES = 201
+
+
+def _palm_box(hand: Hand) -> tuple[tuple[float, float], tuple[float, float]]:
+    """The palm outline's extent; SimulationError unless the outline is that box (an axis-aligned rectangle)."""
+    pts = hand.palm.points
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    corners = {(x, y) for x in (lo[0], hi[0]) for y in (lo[1], hi[1])}
+    if len(pts) != 4 or {tuple(p) for p in pts.tolist()} != corners:
+        raise SimulationError(f"hand {hand.name!r}: the simulated palm is a box; its outline must be an "
+                              "axis-aligned rectangle (4 corners)")
+    return (float(lo[0]), float(lo[1])), (float(hi[0]), float(hi[1]))
+
+
+def derive_body(hand: Hand, rule: ChainRule = ChainRule()) -> Hand:
+    """``hand`` with chains and a palm derived by ``rule`` from its 2-D fingers (module docstring).
+
+    Radii are the fingers' ``radius``. This is how the presets' chains were made
+    (``tools/derive_hand_chains.py``).
+
+    Raises
+    ------
+    SimulationError
+        A finger on an arc, or a travel beyond the reach of the rule's finger.
+    """
+    derived = []
+    for finger in hand.fingers:
+        if not isinstance(finger.trajectory, Ray):
+            raise SimulationError(f"hand {hand.name!r}: finger {finger.name!r} closes on an arc; "
+                                  "chains are derived for straight (ray) trajectories only")
+        length = max(rule.min_length, rule.length_per_travel * finger.travel)
+        l1, l2 = rule.proximal_fraction * length, (1 - rule.proximal_fraction) * length
+        tilt, q1 = _flattest_swing(l1, l2, rule.distal_ratio, finger.travel, finger.name)
+        reach = float(_tip(l1, l2, tilt, q1, rule.distal_ratio, np.linspace(0.0, 1.0, REACH_SAMPLES))[1].max())
+        direction = np.asarray(finger.trajectory.closing_direction)
+        derived.append((finger, l1, l2, tilt, q1, reach, np.asarray(finger.start) + (l1 + l2) * np.sin(tilt) * direction))
+    tip_depth = max(d[5] for d in derived)
+    chains = tuple(FingerChain(knuckle=tuple(knuckle), knuckle_depth=tip_depth - reach,
+                               direction=finger.trajectory.closing_direction, links=(l1, l2), radius=finger.radius,
+                               open_angles=(-tilt, 0.0), closed_angles=(-tilt + q1, rule.distal_ratio * q1))
+                   for finger, l1, l2, tilt, q1, reach, knuckle in derived)
+    knuckles = np.array([c.knuckle for c in chains])
+    (x0, y0), (x1, y1) = knuckles.min(axis=0) - rule.palm_margin, knuckles.max(axis=0) + rule.palm_margin
+    palm = Palm(outline=((x0, y0), (x1, y0), (x1, y1), (x0, y1)), thickness=rule.palm_thickness)
+    try:
+        return replace(hand, chains=chains, palm=palm)
+    except HandError as err:  # the rule's chain strays from the ray: a bug here, not the user's
+        raise SimulationError(f"hand {hand.name!r}: derived chains do not follow the fingers' rays ({err})") from None
+
+
+def _bend(angle: float, dx: float, dy: float) -> str:
+    """The quat attribute of a distal body bent by ``angle`` about the hinge axis; nothing when straight."""
+    if angle == 0:
+        return ""
+    half = angle / 2
+    return f' quat="{_f(np.cos(half))} {_f(-dy * np.sin(half))} {_f(dx * np.sin(half))} 0"'
 
 
 def _tip(l1, l2, tilt, q1_max, ratio, u):

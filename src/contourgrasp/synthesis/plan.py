@@ -167,6 +167,8 @@ class GraspPlan:
     safeguards : Safeguards
     quality : contourgrasp.quality.GraspQuality
         Force closure and Ferrari-Canny L1 epsilon of the grasp points (missed fingers excluded).
+    notes : tuple of str
+        What the plan could not take into account (a property: see :func:`plan_notes`).
     """
 
     pose: np.ndarray
@@ -184,3 +186,18 @@ class GraspPlan:
     refinement: Refinement | None
     safeguards: Safeguards
     quality: GraspQuality
+
+    @property
+    def notes(self) -> tuple[str, ...]:
+        """Notes on what the plan could not take into account (:func:`plan_notes`)."""
+        return plan_notes(self.hand)
+
+
+#: The note of a plan made with a hand that has no 3-D geometry.
+NOTE_2D_HAND = ("hand {name!r} has no 3-D geometry ([fingers.chain], [palm]): planned in 2-D, "
+                "fingertips as points (discs with finger_thickness); finger bodies and palm not considered")
+
+
+def plan_notes(hand) -> tuple[str, ...]:
+    """Notes a plan with ``hand`` carries: :data:`NOTE_2D_HAND` for a hand without chains."""
+    return () if hand.is_3d else (NOTE_2D_HAND.format(name=hand.name),)
