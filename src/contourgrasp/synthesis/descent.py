@@ -1,0 +1,331 @@
+"""Descent check: does the open hand, lowered onto the scene, pass above the height map? (issue 16, item 1.3)
+
+Not yet used by any planner: :func:`descent_clearance` and :func:`descent_feasible` are the exact
+check of candidate poses; the per-yaw screening bound over the whole grid and the wiring into
+:func:`~contourgrasp.synthesis.search` are the next steps.
+
+The model
+---------
+A planar pose (x, y, yaw) places the 3-D hand frame as :func:`contourgrasp.pipeline.hand_pose`
+does: its x, y axes the planning frame's turned by yaw, its z axis the planning z (the approach
+axis, into the table). The open hand (closing progress s = 0) descends along that axis until its
+lowest fingertip -- the lowest of the chains' tips (:func:`~contourgrasp.hand.chain_tip`, the
+centre of the distal link's end cap, the point the simulation's ``tip_depth`` measures) -- is
+``tip_height`` above the table. Heights of hand points are the map's, along the table's normal
+(:meth:`HeightMap.height_of`), so a slightly tilted table normal is taken exactly.
+
+Bodies: per finger (in the hand's order) its post, proximal and distal capsules
+(:func:`~contourgrasp.hand.chain_capsules` at s = 0, radius ``chain.radius``), then the palm slab
+(its outline from z = -thickness to 0, whose lowest point is its underside at z = 0):
+``3 * n_fingers + 1`` bodies, named by :func:`body_names`.
+
+Why the final pose decides the whole descent
+--------------------------------------------
+The height map is a 2.5-D solid: every cell a column filled from the table up to its height. The
+hand moves by a pure translation along those columns, so the set of cells under each body does
+not change on the way down and every body point only gets lower. A body passes above a cell for
+the whole descent exactly when its lowest point over that cell, at the end, is above the cell's
+height: the clearance of a body is ``min over the cells under it of (height of the body's lowest
+point over the cell, at the grasp pose) - (cell's height)``. Negative: the body strikes that
+cell's surface on the way down, by that much.
+
+Cells
+-----
+A cell is represented by its centre: it is under a body when the vertical line through its centre
+meets the body, and the body's lowest point over it is taken on that line (the map's value is
+already the highest surface point of the whole cell's column). The discretisation error is that
+of moving a body horizontally by up to half a cell's diagonal (1.4 mm at 2 mm cells); a margin
+(``descent_feasible(margin=...)``) covers it when needed.
+
+Unseen cells take the map's conservative upper bound (:meth:`HeightMap.conservative`, never free
+space); a body over a cell out of the camera's view (+inf) or off the grid gets clearance -inf.
+
+Lowest point of a capsule over a vertical line (exact)
+-------------------------------------------------------
+A capsule (axis A -> B, length L, unit axis u, radius r) is the union of a finite cylinder and the
+balls at its ends, so its lowest point on a vertical line (z down, the largest z) is the largest of
+the three parts' lowest points:
+
+* the ball at A: ``z = A_z + sqrt(r^2 - d^2)`` where the line's horizontal distance d from A is
+  at most r (the same for B);
+* the cylinder's lateral surface: on the line ``P = (q, z)``, with ``w0 = (q - A_xy, 0)``,
+  ``a = w0 . u`` and ``b = u_z``, ``|P - A|^2 - ((P - A) . u)^2 = r^2`` reads, for
+  ``z' = z - A_z``, ``(1 - b^2) z'^2 - 2 a b z' + |w0|^2 - a^2 - r^2 = 0``; its larger root
+  ``z' = (a b + sqrt(a^2 b^2 - (1 - b^2)(|w0|^2 - a^2 - r^2))) / (1 - b^2)`` is the lowest point
+  of the infinite cylinder, kept when its axial coordinate ``t = a + z' b`` lies in [0, L]
+  (otherwise the finite cylinder's lowest point on the line is on an end disc, inside that end's
+  ball, which already counts). A vertical axis (``1 - b^2`` ~ 0, the posts) has only the balls'.
+
+For a finger leaning outward by ``tilt`` and a wall edge of height H crossed by its distal link,
+this gives the issue's rule: the tip must start ``r / cos(tilt) + tan(tilt) (H - h_tip)``
+outside the edge (the vertical half-thickness of an inclined cylinder is ``r / sin(tilt)``
+about its axis).
+
+Cost
+----
+Per pose, each capsule is evaluated on the cells of a square window around its footprint (the
+window's half-side its footprint's bounding radius plus a cell), and the palm on the cells of its
+outline's window with an even-odd point-in-polygon test: about 10^4 cells a pose for the presets,
+in batches of poses. See the README for the measured time.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import validation
+from ..errors import HandError, PerceptionError, PlannerError
+from ..hand import Hand, chain_capsules, chain_tip
+from ..perception.height_map import HeightMap
+
+#: Parts of a finger's chain, in the order of :func:`~contourgrasp.hand.chain_capsules`.
+FINGER_PARTS = ("post", "proximal", "distal")
+
+#: Poses evaluated at once (bounds the arrays: a batch x a window's cells).
+_POSE_BATCH = 128
+
+#: An axis with ``1 - u_z^2`` below this is vertical: its capsule's lowest points are its end balls'.
+_VERTICAL = 1e-12
+
+
+@dataclass(frozen=True, eq=False)
+class DescentCheck:
+    """What :func:`descent_feasible` found.
+
+    Attributes
+    ----------
+    feasible : (p,) bool
+        Every body clears the map by at least ``margin`` over the whole descent.
+    clearance : (p, n_bodies) float
+        :func:`descent_clearance`, m.
+    blocking : (p,) int
+        Index into ``bodies`` of the body with the least clearance where infeasible, -1 where feasible.
+    bodies : tuple of str
+        :func:`body_names`.
+    margin : float
+        The clearance asked for, m.
+    """
+
+    feasible: np.ndarray
+    clearance: np.ndarray
+    blocking: np.ndarray
+    bodies: tuple[str, ...]
+    margin: float
+
+    def reason(self, i: int) -> str:
+        """Why pose ``i`` is refused (or that it is not), e.g. "the index distal strikes the map 3.0 mm deep"."""
+        b = int(self.blocking[i])
+        if b < 0:
+            return f"the open hand clears the height map by {1000 * float(self.clearance[i].min()):.1f} mm"
+        c = float(self.clearance[i, b])
+        if c == -math.inf:
+            return f"the {self.bodies[b]} passes over cells out of the camera's view or off the height map"
+        if c < 0:
+            return f"the {self.bodies[b]} strikes the height map {1000 * -c:.1f} mm deep while descending"
+        return (f"the {self.bodies[b]} clears the height map by only {1000 * c:.1f} mm "
+                f"(margin {1000 * self.margin:g} mm)")
+
+
+def body_names(hand: Hand) -> tuple[str, ...]:
+    """Names of the bodies of :func:`descent_clearance`'s columns: "<finger> <part>" per finger and part, then "palm"."""
+    _check_hand(hand)
+    return tuple(f"{f.name} {part}" for f in hand.fingers for part in FINGER_PARTS) + ("palm",)
+
+
+def descent_clearance(hand: Hand, heights: HeightMap, poses, tip_height) -> np.ndarray:
+    """Smallest vertical clearance of each body of the open hand over the height map during its descent.
+
+    Parameters
+    ----------
+    hand : Hand
+        A 3-D hand (:attr:`Hand.is_3d`).
+    heights : HeightMap
+        The scene, in the planning frame the poses are in.
+    poses : (p, 3) float
+        Planar poses (x, y, yaw) in the planning frame, m and rad.
+    tip_height : float or (p,) float
+        Height above the table of the open hand's lowest fingertip (tip centre) at the end of the descent, m.
+
+    Returns
+    -------
+    (p, 3 * n_fingers + 1) float
+        Per pose and body (:func:`body_names`), m: the least over the cells under the body of its
+        lowest point's height minus the cell's (module docstring); +inf for a body over no cell,
+        -inf over a cell out of view or off the grid. Negative: the body strikes.
+
+    Raises
+    ------
+    HandError
+        ``hand`` is not a Hand, or has no 3-D geometry.
+    PerceptionError
+        ``heights`` is not a HeightMap, or its table normal is not along the approach axis.
+    PlannerError
+        ``poses`` or ``tip_height`` not finite or of the wrong shape.
+    """
+    _check_hand(hand)
+    poses, tip, normal = _check_inputs(heights, poses, tip_height)
+    layer = heights.conservative()
+    out = np.empty((len(poses), 3 * len(hand.chains) + 1))
+    capsules = [(c.radius, chain_capsules(c, 0.0)[0]) for c in hand.chains]
+    tips = np.array([chain_tip(c, 0.0)[0] for c in hand.chains])  # (n, 3)
+    for a in range(0, len(poses), _POSE_BATCH):
+        sl = slice(a, a + _POSE_BATCH)
+        out[sl] = _batch(hand, heights, layer, normal, capsules, tips, poses[sl], tip[sl])
+    return out
+
+
+def descent_feasible(hand: Hand, heights: HeightMap, poses, tip_height, *, margin: float = 0.0) -> DescentCheck:
+    """Which poses the open hand can descend to without any body passing below the map (plus ``margin``).
+
+    Parameters are :func:`descent_clearance`'s, and ``margin`` (m, in [0, ``MAX_HAND_SIZE``]) the
+    clearance every body must keep.
+
+    Returns
+    -------
+    DescentCheck
+        Feasibility per pose, the clearances, and the body that blocks first (the least clearance).
+
+    Raises
+    ------
+    HandError, PerceptionError, PlannerError
+        As :func:`descent_clearance`; PlannerError for a bad ``margin``.
+    """
+    from ..tolerances import MAX_HAND_SIZE
+
+    margin = validation.bounded("margin", margin, MAX_HAND_SIZE, " m", error=PlannerError)
+    clearance = descent_clearance(hand, heights, poses, tip_height)
+    worst = clearance.argmin(axis=1) if clearance.size else np.zeros(0, dtype=int)
+    feasible = clearance.min(axis=1) >= margin if len(clearance) else np.zeros(0, dtype=bool)
+    return DescentCheck(feasible=feasible, clearance=clearance, blocking=np.where(feasible, -1, worst),
+                        bodies=body_names(hand), margin=margin)
+
+
+def _check_hand(hand) -> None:
+    if not isinstance(hand, Hand):
+        raise HandError(f"hand must be a contourgrasp.Hand, got {type(hand).__name__}")
+    if not hand.is_3d:
+        raise HandError(f"hand {hand.name!r} has no 3-D geometry (finger chains and a palm): "
+                        "the descent check needs the hand's bodies")
+
+
+def _check_inputs(heights, poses, tip_height):
+    if not isinstance(heights, HeightMap):
+        raise PerceptionError(f"heights must be a contourgrasp.perception.HeightMap, got {type(heights).__name__}")
+    normal = np.asarray(heights.table_normal, dtype=float)
+    if normal.shape != (3,) or not np.isfinite(normal).all() or normal[2] > -0.5:
+        raise PerceptionError(f"heights.table_normal must point up the approach axis (z component < -0.5), "
+                              f"got {heights.table_normal!r}")
+    poses = validation.finite_array("poses", poses, (None, 3), error=PlannerError)
+    tip = validation.float_array("tip_height", tip_height, error=PlannerError)
+    if tip.ndim == 0:
+        tip = np.full(len(poses), float(tip))
+    if tip.shape != (len(poses),):
+        raise PlannerError(f"tip_height must be a number or one per pose ({len(poses)}), got shape {tip.shape}")
+    validation.finite_array("tip_height", tip, error=PlannerError)
+    return poses, tip, normal
+
+
+def _window(centre_xy, half, heights):
+    """Cells of a square window of half-side ``half`` (m) around points (B, 2): rows, cols (B, m) and their centres (B, m, 2)."""
+    k = int(math.ceil(half / heights.cell)) + 1
+    off = np.arange(-k, k + 1)
+    dj, di = (g.ravel() for g in np.meshgrid(off, off))
+    base = np.floor((centre_xy - heights.origin) / heights.cell).astype(np.intp)  # (B, 2): col, row
+    cols = base[:, :1] + dj[None]
+    rows = base[:, 1:] + di[None]
+    centres = np.stack([heights.origin[0] + (cols + 0.5) * heights.cell,
+                        heights.origin[1] + (rows + 0.5) * heights.cell], axis=-1)
+    return rows, cols, centres
+
+
+def _cell_heights(layer, rows, cols):
+    """The layer at cells (any shape); +inf off the grid."""
+    ny, nx = layer.shape
+    inside = (rows >= 0) & (rows < ny) & (cols >= 0) & (cols < nx)
+    return np.where(inside, layer[np.clip(rows, 0, ny - 1), np.clip(cols, 0, nx - 1)], np.inf)
+
+
+def _to_hand(centres, poses):
+    """Planning-frame points (B, m, 2) in the hand frame of each pose: R(yaw)^T (p - (x, y))."""
+    c, s = np.cos(poses[:, 2])[:, None], np.sin(poses[:, 2])[:, None]
+    dx, dy = centres[..., 0] - poses[:, :1], centres[..., 1] - poses[:, 1:2]
+    return c * dx + s * dy, -s * dx + c * dy
+
+
+def _lowest_z(qx, qy, A, B, r):
+    """(B, m) float: the capsule's lowest point (largest z) on the vertical lines at hand-frame (qx, qy); -inf off it."""
+    low = np.full(qx.shape, -np.inf)
+    for end in (A, B):
+        d2 = (qx - end[0]) ** 2 + (qy - end[1]) ** 2
+        with np.errstate(invalid="ignore"):
+            low = np.maximum(low, np.where(d2 <= r * r, end[2] + np.sqrt(np.maximum(r * r - d2, 0.0)), -np.inf))
+    axis = B - A
+    length = float(np.linalg.norm(axis))
+    if length > 0:
+        u = axis / length
+        k = 1.0 - u[2] ** 2
+        if k > _VERTICAL:
+            wx, wy = qx - A[0], qy - A[1]
+            a = wx * u[0] + wy * u[1]
+            w2 = wx * wx + wy * wy
+            disc = (a * u[2]) ** 2 - k * (w2 - a * a - r * r)
+            with np.errstate(invalid="ignore"):
+                z = (a * u[2] + np.sqrt(disc)) / k
+            t = a + z * u[2]
+            ok = (disc >= 0) & (t >= 0) & (t <= length)
+            low = np.maximum(low, np.where(ok, A[2] + z, -np.inf))
+    return low
+
+
+def _inside_polygon(qx, qy, polygon):
+    """(B, m) bool: even-odd test of hand-frame points against the polygon (k, 2)."""
+    inside = np.zeros(qx.shape, dtype=bool)
+    x0, y0 = polygon[:, 0], polygon[:, 1]
+    x1, y1 = np.roll(x0, -1), np.roll(y0, -1)
+    for a, b, c, d in zip(x0, y0, x1, y1):
+        if b == d:
+            continue
+        crosses = (b > qy) != (d > qy)
+        x_at = a + (qy - b) * (c - a) / (d - b)
+        inside ^= crosses & (qx < x_at)
+    return inside
+
+
+def _batch(hand, heights, layer, normal, capsules, tips, poses, tip):
+    """descent_clearance for one batch of poses."""
+    c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
+
+    def planning_xy(hxy):  # hand-frame (2,) -> planning (B, 2)
+        return np.stack([poses[:, 0] + c * hxy[0] - s * hxy[1], poses[:, 1] + s * hxy[0] + c * hxy[1]], axis=-1)
+
+    # Height of a hand point at planning (x, y) and hand depth z: n_xy . (x, y) + n_z z + base, with base
+    # fixed by the lowest tip being at tip_height (the palm's planning depth cancels out).
+    tip_xy = np.stack([planning_xy(t[:2]) for t in tips], axis=1)  # (B, n, 2)
+    g = tip_xy @ normal[:2] + normal[2] * tips[:, 2][None]
+    base = tip - g.min(axis=1)  # (B,)
+
+    def clearance(low_z, centres, rows, cols):
+        h = centres @ normal[:2] + normal[2] * low_z + base[:, None]
+        cell = _cell_heights(layer, rows, cols)
+        with np.errstate(invalid="ignore"):
+            gap = np.where(np.isfinite(low_z), h - cell, np.inf)
+        return gap.min(axis=1)
+
+    columns = []
+    for r, caps in capsules:
+        for A, B in caps:
+            lo = np.minimum(A[:2], B[:2]) - r
+            hi = np.maximum(A[:2], B[:2]) + r
+            centre, half = (lo + hi) / 2, float(np.linalg.norm(hi - lo)) / 2
+            rows, cols, centres = _window(planning_xy(centre), half, heights)
+            qx, qy = _to_hand(centres, poses)
+            columns.append(clearance(_lowest_z(qx, qy, A, B, r), centres, rows, cols))
+    outline = hand.palm.points
+    lo, hi = outline.min(axis=0), outline.max(axis=0)
+    rows, cols, centres = _window(planning_xy((lo + hi) / 2), float(np.linalg.norm(hi - lo)) / 2, heights)
+    qx, qy = _to_hand(centres, poses)
+    columns.append(clearance(np.where(_inside_polygon(qx, qy, outline), 0.0, -np.inf), centres, rows, cols))
+    return np.stack(columns, axis=1)

@@ -1,0 +1,203 @@
+"""The descent check against analytic truth (issue 16, item 1.3): a flat wall, a vertical cylinder, the lean rule."""
+
+import math
+
+import numpy as np
+import pytest
+
+from contourgrasp import load_hand
+from contourgrasp.errors import HandError, PerceptionError, PlannerError
+from contourgrasp.hand import Hand, chain_tip
+from contourgrasp.perception import HeightMap
+from contourgrasp.synthesis.descent import body_names, descent_clearance, descent_feasible
+
+CELL = 0.002
+CAMERA = 0.7  # camera height above the table: a point at planning depth z is 0.7 - z above it
+
+
+@pytest.fixture(scope="module")
+def hand():
+    return load_hand("five-finger-linear")
+
+
+def scene(height, *, origin=(-0.4, -0.4), shape=(400, 400), in_view=None):
+    """A synthetic top-down HeightMap: ``height(x, y)`` at the cells' centres (y rows, x columns)."""
+    ny, nx = shape
+    x = origin[0] + (np.arange(nx) + 0.5) * CELL
+    y = origin[1] + (np.arange(ny) + 0.5) * CELL
+    h = np.asarray(height(*np.meshgrid(x, y)), dtype=float) * np.ones(shape)
+    return HeightMap(
+        heights=h, cell=CELL, origin=np.array(origin, dtype=float), object=h > 0.01, obstacles=np.zeros(shape, bool),
+        max_height=float(np.nanmax(h)), in_view=np.ones(shape, bool) if in_view is None else in_view,
+        table_normal=np.array([0.0, 0.0, -1.0]), table_offset=CAMERA, camera_xy=np.zeros(2), camera_height=CAMERA,
+    )
+
+
+def finger(hand, name):
+    i = [f.name for f in hand.fingers].index(name)
+    return i, hand.chains[i]
+
+
+def lean(chain):
+    """(tilt, radius) of an open chain hanging straight (q2 = 0)."""
+    assert chain.open_angles[1] == 0.0
+    return -chain.open_angles[0], chain.radius
+
+
+def offset(chain, wall, tip_height):
+    """The issue's rule: how far outside a wall edge of height ``wall`` the tip must start, m."""
+    tilt, r = lean(chain)
+    return r / math.cos(tilt) + math.tan(tilt) * (wall - tip_height)
+
+
+def middle_pose(hand, edge_y, wall, tip_height, clearance):
+    """A yaw-0 pose whose middle finger's axis lies on a cell-centre column and whose tip is
+    ``offset`` for ``wall + clearance`` outside the edge row ``edge_y`` (+y: the middle finger leans to +y)."""
+    _, chain = finger(hand, "middle")
+    tip = chain_tip(chain, 0.0)[0]
+    x = -tip[0] + 0.5 * CELL  # the axis over the column of centres at x = 0.001
+    y = edge_y + offset(chain, wall + clearance, tip_height) - tip[1]
+    return np.array([x, y, 0.0])
+
+
+# A rim: a thin wall of height H under the middle finger only, its last row of cell centres at EDGE.
+H, TIP, EDGE = 0.04, 0.02, 0.1 + 0.5 * CELL
+
+
+def rim(x, y):
+    return np.where((np.abs(x) < 0.006) & (y < EDGE + 1e-9) & (y > EDGE - 0.01), H, 0.0)
+
+
+def test_a_finger_1mm_over_a_rim_clears_it_by_1mm_and_2mm_lower_strikes(hand):
+    hm = scene(rim)
+    names = body_names(hand)
+    pose = middle_pose(hand, EDGE, H, TIP, 0.001)
+    check = descent_feasible(hand, hm, [pose], TIP)
+    assert check.clearance[0, names.index("middle distal")] == pytest.approx(0.001, abs=1e-9)
+    assert check.feasible[0] and check.blocking[0] == -1
+    lower = descent_feasible(hand, hm, [pose], TIP - 0.002)
+    assert lower.clearance[0, names.index("middle distal")] == pytest.approx(-0.001, abs=5e-4)
+    assert not lower.feasible[0]
+    assert names[lower.blocking[0]] == "middle distal"
+    assert "middle distal strikes" in lower.reason(0)
+    # 1 mm clear passes a 0 margin but not a 2 mm one
+    assert not descent_feasible(hand, hm, [pose], TIP, margin=0.002).feasible[0]
+
+
+def test_a_vertical_cylinder_rim(hand):
+    # A thin can (a bottle's neck) under the middle finger, its rim's apex on the row of centres at EDGE, column x = 0.001
+    radius, centre_y = 0.008, EDGE - 0.008
+    hm = scene(lambda x, y: np.where(np.hypot(x - 0.5 * CELL, y - centre_y) <= radius + 1e-9, H, 0.0))
+    names = body_names(hand)
+    for clear, expect_feasible in ((0.001, True), (-0.001, False)):
+        check = descent_feasible(hand, hm, [middle_pose(hand, EDGE, H, TIP, clear)], TIP)
+        distal = check.clearance[0, names.index("middle distal")]
+        assert distal == pytest.approx(clear, abs=1e-9)
+        assert check.feasible[0] == expect_feasible
+        if not expect_feasible:
+            assert names[check.blocking[0]] == "middle distal"
+
+
+@pytest.mark.parametrize("name, wall", [("middle", 0.03), ("middle", 0.08), ("thumb", 0.05)])
+def test_the_lean_rule_r_over_cos_plus_tan_times_wall_height(hand, name, wall):
+    """The clearance of the finger's lowest body changes sign where the issue's rule says, within a cell."""
+    i, chain = finger(hand, name)
+    tip = chain_tip(chain, 0.0)[0]
+    outward = np.asarray(chain.direction) * -1.0  # open fingers lean away from their flexion direction
+    yaw = math.atan2(1.0, 0.0) - math.atan2(outward[1], outward[0])  # turn the lean to +y
+    c, s = math.cos(yaw), math.sin(yaw)
+    tip_xy = np.array([c * tip[0] - s * tip[1], s * tip[0] + c * tip[1]])
+    tilt, _ = lean(chain)
+    # this finger's own tip height: the lowest tip is at TIP (the thumb's hangs higher than the others')
+    own_tip = TIP + max(chain_tip(ch, 0.0)[0][2] for ch in hand.chains) - tip[2]
+    need = offset(chain, wall, own_tip)
+    assert (name == "thumb") or need == pytest.approx(0.0095 + 0.33 * (wall - TIP), abs=5e-4)
+    hm = scene(lambda x, y: np.where(y < EDGE + 1e-9, wall, 0.0))
+    starts = need + np.linspace(-2 * CELL, 2 * CELL, 41)
+    poses = np.c_[np.full(len(starts), 0.5 * CELL - tip_xy[0]), EDGE + starts - tip_xy[1], np.full(len(starts), yaw)]
+    cols = [3 * i + 1, 3 * i + 2]  # proximal, distal
+    clearance = descent_clearance(hand, hm, poses, TIP)[:, cols].min(axis=1)
+    assert clearance[0] < 0 < clearance[-1]
+    assert np.all(np.diff(clearance) >= -1e-12)
+    crossing = float(np.interp(0.0, clearance, starts))
+    assert abs(crossing - need) <= CELL
+    if name == "middle":  # an axis-aligned finger over a centre column: exact
+        assert crossing == pytest.approx(need, abs=1e-4)
+        # and the clearance there grows at cos(tilt) / sin(tilt) per m of tip offset
+        near = np.abs(starts - need) <= CELL  # while the edge is under the link's side, not its end
+        slope = np.polyfit(starts[near], clearance[near], 1)[0]
+        assert slope == pytest.approx(1.0 / math.tan(tilt), rel=1e-6)
+
+
+def test_an_object_lower_than_the_tips_changes_nothing(hand):
+    table = scene(lambda x, y: 0.0)
+    box = scene(lambda x, y: np.where((np.abs(x) < 0.05) & (np.abs(y - 0.1) < 0.05), 0.005, 0.0))
+    rng = np.random.default_rng(3)
+    poses = np.c_[rng.uniform(-0.02, 0.02, 50), rng.uniform(-0.02, 0.02, 50), rng.uniform(-np.pi, np.pi, 50)]
+    a = descent_clearance(hand, table, poses, 0.02)
+    b = descent_feasible(hand, box, poses, 0.02)
+    assert b.feasible.all() and (a > 0).all()
+    # on a bare table the lowest body is a fingertip's end cap: tip height minus its radius, within a cell
+    lowest = a.min(axis=1)
+    r = min(ch.radius for ch in hand.chains)
+    assert np.all(lowest >= 0.02 - r - 1e-12) and np.all(lowest <= 0.02 - r + 0.15e-3)
+    # and below its radius the tip strikes the table itself
+    assert not descent_feasible(hand, table, poses, r - 0.001).feasible.any()
+
+
+def test_unseen_cells_are_bounded_and_out_of_view_blocks(hand):
+    names = body_names(hand)
+    pose = middle_pose(hand, EDGE, H, TIP, 0.001)
+
+    def tall(x, y):  # the rim, and a tall post far from the hand, so unseen cells get a bound above the tips
+        return np.where((np.abs(x + 0.15) < 0.01) & (np.abs(y + 0.05) < 0.01), 0.15, rim(x, y))
+
+    seen = scene(tall)
+    assert descent_feasible(hand, seen, [pose], TIP).feasible[0]
+    hidden = scene(tall)
+    hidden.heights[hidden.centres()[1] > 0.05] = np.nan  # unseen around the hand: no seen cell can have hidden it
+    bounded = descent_clearance(hand, hidden, [pose], TIP)
+    as_bound = descent_clearance(hand, scene(lambda x, y: hidden.conservative()), [pose], TIP)
+    np.testing.assert_array_equal(bounded, as_bound)
+    assert bounded[0, names.index("middle distal")] < 0  # not free space: bounded by the post's 0.15 m
+    # a cell out of the camera's view under the finger: -inf, refused
+    in_view = np.ones(seen.shape, bool)
+    in_view[~hidden.seen] = False
+    out = scene(tall, in_view=in_view)
+    out.heights[~in_view] = np.nan
+    check = descent_feasible(hand, out, [pose], TIP)
+    assert check.clearance[0, names.index("middle distal")] == -np.inf and not check.feasible[0]
+    assert "out of the camera's view" in check.reason(0)
+    # off the grid: the same
+    far = descent_feasible(hand, seen, [[5.0, 5.0, 0.0]], TIP)
+    assert (far.clearance == -np.inf).all()
+
+
+def test_the_palm_strikes_a_tall_object_beneath_it(hand):
+    hm = scene(lambda x, y: np.where((np.abs(x) < 0.01) & (np.abs(y - 0.14) < 0.01), 0.2, 0.0))
+    check = descent_feasible(hand, hm, [[0.0, 0.0, 0.0]], TIP)
+    assert body_names(hand)[check.blocking[0]] == "palm"
+    palm_height = TIP + chain_tip(hand.chains[2], 0.0)[0][2]  # every tip is as deep; palm underside above them
+    assert check.clearance[0, -1] == pytest.approx(palm_height - 0.2, abs=1e-9)
+
+
+def test_bad_arguments_are_refused_by_name(hand):
+    hm = scene(lambda x, y: 0.0)
+    with pytest.raises(HandError, match="no 3-D geometry"):
+        descent_clearance(Hand(name="flat", fingers=hand.fingers, min_touching=3), hm, [[0, 0, 0]], 0.02)
+    with pytest.raises(PerceptionError, match="heights"):
+        descent_clearance(hand, hm.heights, [[0, 0, 0]], 0.02)
+    with pytest.raises(PlannerError, match="poses"):
+        descent_clearance(hand, hm, [[0, 0]], 0.02)
+    with pytest.raises(PlannerError, match="poses"):
+        descent_clearance(hand, hm, [[0, np.nan, 0]], 0.02)
+    with pytest.raises(PlannerError, match="tip_height"):
+        descent_clearance(hand, hm, [[0, 0, 0]], [0.02, 0.03])
+    with pytest.raises(PlannerError, match="tip_height"):
+        descent_clearance(hand, hm, [[0, 0, 0]], np.inf)
+    with pytest.raises(PlannerError, match="margin"):
+        descent_feasible(hand, hm, [[0, 0, 0]], 0.02, margin=-1.0)
+    assert descent_clearance(hand, hm, np.zeros((0, 3)), 0.02).shape == (0, 3 * len(hand.fingers) + 1)
+    # a per-pose tip height is the same as one at a time
+    both = descent_clearance(hand, hm, [[0, 0, 0], [0, 0, 1]], [0.01, 0.03])
+    np.testing.assert_array_equal(both[1], descent_clearance(hand, hm, [[0, 0, 1]], 0.03)[0])
