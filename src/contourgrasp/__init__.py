@@ -1,17 +1,20 @@
 """contourgrasp: contour-based grasp synthesis for multi-fingered, underactuated hands.
 
-The pipeline, one module per stage (thesis chapter 3):
+The pipeline, one package or module per stage (thesis chapter 3):
 
-* :mod:`contourgrasp.efd` — contour model: Elliptic Fourier Descriptors, curvature (3.2)
-* :mod:`contourgrasp.hand` — finger trajectories and hands (3.3)
+* :mod:`contourgrasp.perception` — RGB-D frame -> object contour in meters, height map (3.1)
+* :mod:`contourgrasp.contour` — contour model: Elliptic Fourier Descriptors, curvature (3.2);
+  :mod:`contourgrasp.efd` is its older name
+* :mod:`contourgrasp.hand` — finger trajectories, finger chains and hands (3.3)
 * :mod:`contourgrasp.synthesis` — inner and outer problems, the grasp plan (3.4)
 * :mod:`contourgrasp.quality` — force closure and the Ferrari-Canny epsilon (6.1 item 2)
-* :mod:`contourgrasp.perception` — RGB-D frame -> object contour in meters (3.1)
 * :mod:`contourgrasp.pipeline` — perception + synthesis -> 6-DoF grasp pose (4.1.4)
-* :mod:`contourgrasp.sim` — MuJoCo simulation of the grasping experiment (4.2.4)
 * :mod:`contourgrasp.visualize` — figures
-* :mod:`contourgrasp.io` — file formats (contours, hands, planners, plans)
-* :mod:`contourgrasp.cli` — the ``contourgrasp`` command
+* :mod:`contourgrasp.sim` — MuJoCo simulation of the grasping experiment and the bench (4.2.4)
+* :mod:`contourgrasp.io` — file formats (contours, hands, planners, camera files, bags, plans)
+* :mod:`contourgrasp.validation`, :mod:`contourgrasp.tolerances`, :mod:`contourgrasp.errors` —
+  argument checks, thresholds, exceptions
+* :mod:`contourgrasp.cli`, :mod:`contourgrasp.ros` — the ``contourgrasp`` command and the ROS 2 node
 """
 
 from __future__ import annotations
