@@ -124,6 +124,11 @@ def _parser() -> argparse.ArgumentParser:
                       help="meters per unit of integer depth images (default 0.001: millimetres)")
     plan.add_argument("--segment", choices=("auto", "rgb", "depth"), default="auto")
     plan.add_argument("--mask", help="binary image of the object: skips segmentation")
+    target = plan.add_mutually_exclusive_group()
+    target.add_argument("--target", type=_target_pixel, metavar="U,V",
+                        help="plan on the object under this depth pixel (default: the largest wholly visible one)")
+    target.add_argument("--roi", type=_roi, metavar="X,Y,W,H",
+                        help="plan on the wholly visible object with most pixels in this box")
     plan.add_argument("--depth-mode", choices=("max", "plane"),
                       help="contour plane: 'max' (thesis eq 3.1-3.2; the footprint on the table when the camera is "
                            "tilted) or the object's top 'plane' (default: the planner's)")
@@ -159,6 +164,27 @@ def _pixel_pair(text: str) -> tuple[int, int]:
     except ValueError:
         raise argparse.ArgumentTypeError(f"must be two integers DX,DY, got {_shown(text)}") from None
     return dx, dy
+
+
+def _integers(text: str, count: int, names: str) -> tuple[int, ...]:
+    try:
+        values = tuple(int(part) for part in text.split(","))
+    except ValueError:
+        values = ()
+    if len(values) != count:
+        raise argparse.ArgumentTypeError(f"must be {count} integers {names}, got {_shown(text)}")
+    return values
+
+
+def _target_pixel(text: str) -> tuple[int, int]:
+    return _integers(text, 2, "U,V")
+
+
+def _roi(text: str) -> tuple[int, int, int, int]:
+    x, y, w, h = _integers(text, 4, "X,Y,W,H")
+    if w <= 0 or h <= 0:
+        raise argparse.ArgumentTypeError(f"W and H must be positive, got {_shown(text)}")
+    return x, y, w, h
 
 
 def _harmonics(text: str):
@@ -314,6 +340,8 @@ def _plan(args) -> int:
         approach_offset=args.approach_offset,
         standoff=args.standoff,
         T_base_camera=None if args.extrinsics is None else read_extrinsics(args.extrinsics),
+        target_px=args.target,
+        roi=args.roi,
         **_plan_options(args),
     )
 

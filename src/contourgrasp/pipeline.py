@@ -59,6 +59,14 @@ class ImageGraspPlan:
     height_map : HeightMap or None
         Heights above the table around the object, in the planning frame of ``metric``
         (:func:`contourgrasp.perception.height_map`); None when no table plane was found.
+    candidates : tuple of Candidate
+        Every region standing on the table (:func:`contourgrasp.perception.find_candidates`),
+        largest first; empty when depth found no table plane.
+    target : Candidate or None
+        The candidate planned on (:func:`contourgrasp.perception.choose_target`); None when the
+        object did not come from the depth candidates (the RGB method found it) and overlaps none.
+    target_reason : str
+        Why that object was planned on, one line.
     """
 
     plan: GraspPlan
@@ -70,6 +78,9 @@ class ImageGraspPlan:
     T_base_hand: np.ndarray | None
     filled_depth_px: int
     height_map: HeightMap | None = None
+    candidates: tuple = ()
+    target: perception.Candidate | None = None
+    target_reason: str = ""
 
     @property
     def quaternion_xyzw(self) -> np.ndarray:
@@ -92,6 +103,8 @@ def plan_frame(
     approach_offset: float = APPROACH_OFFSET,
     standoff: float = 0.10,
     T_base_camera=None,
+    target_px=None,
+    roi=None,
     **synthesis_options,
 ) -> ImageGraspPlan:
     """Plan a grasp on one RGB-D frame with a :class:`~contourgrasp.hand.Hand`.
@@ -133,6 +146,14 @@ def plan_frame(
     T_base_camera : (4, 4) float, optional
         Camera pose in the robot's base frame, a rigid transform (checked as
         :func:`contourgrasp.io.camera_file.read_extrinsics` checks a file's).
+    target_px : (int, int), optional
+        Plan on the object under this pixel (u, v) of the depth image.
+    roi : (int, int, int, int), optional
+        Plan on the wholly visible object with most pixels in this box (x, y, w, h).
+        Without ``target_px`` and ``roi`` the object is the largest wholly visible region
+        standing on the table, as always (:func:`contourgrasp.perception.choose_target`);
+        regions touching the image border are listed in ``candidates`` but never chosen.
+        Both need depth segmentation (not ``mask`` or ``segment="rgb"``).
     **synthesis_options
         Keyword options of :func:`contourgrasp.synthesis.search`.
 
@@ -156,9 +177,10 @@ def plan_frame(
         T_base_camera = validation.rigid_transform("T_base_camera", T_base_camera, error=PerceptionError,
                                                    rotation_tolerance=ROTATION_TOLERANCE,
                                                    row_tolerance=HOMOGENEOUS_ROW)
-    seg, metric, filled, d = _perceive(rgb, depth, intrinsics, segment=segment, mask=mask, depth_mode=depth_mode,
-                                       footprint=footprint, fill_holes=fill_holes, colour_offset_px=colour_offset_px,
-                                       approach_offset=approach_offset)
+    seg, metric, filled, d, scene = _perceive(rgb, depth, intrinsics, segment=segment, mask=mask, depth_mode=depth_mode,
+                                              footprint=footprint, fill_holes=fill_holes,
+                                              colour_offset_px=colour_offset_px, approach_offset=approach_offset,
+                                              target_px=target_px, roi=roi)
     heights = scene_heights(d, intrinsics, seg, metric)
     plan = search(metric.contour_xy, hand, **synthesis_options)
     T_camera_hand = hand_pose(metric, plan.pose, metric.approach_depth)
@@ -166,7 +188,7 @@ def plan_frame(
     T_camera_pregrasp[:3, 3] -= standoff * T_camera_hand[:3, 2]
     T_base_hand = None if T_base_camera is None else T_base_camera @ T_camera_hand
     return ImageGraspPlan(plan, seg, metric, intrinsics, T_camera_hand, T_camera_pregrasp, T_base_hand, filled,
-                          heights)
+                          heights, *scene)
 
 
 def perceive(
@@ -192,9 +214,19 @@ def perceive(
 
 
 def _perceive(rgb, depth, intrinsics, *, segment, mask, depth_mode, footprint, fill_holes, colour_offset_px,
-              approach_offset):
-    """:func:`perceive`, and the depth image it worked on (holes filled)."""
+              approach_offset, target_px=None, roi=None):
+    """:func:`perceive`, the depth image it worked on (holes filled), and (candidates, target, reason)."""
     _check_options(intrinsics, segment, depth_mode, footprint, fill_holes, colour_offset_px, approach_offset)
+    chosen = target_px is not None or roi is not None
+    if target_px is not None and roi is not None:
+        raise PerceptionError("give target_px or roi, not both")
+    shape = (intrinsics.height, intrinsics.width)
+    if target_px is not None:
+        target_px = perception.candidates.check_pixel(target_px, shape)
+    if roi is not None:
+        roi = perception.candidates.check_roi(roi, shape)
+    if chosen and (mask is not None or segment == "rgb"):
+        raise PerceptionError("target_px and roi choose among the depth candidates: not with a mask or segment='rgb'")
     d = perception.as_depth(depth)
     intrinsics.check_shape(d.shape, "depth image")
     if not perception.valid_depth(d).any():
@@ -204,15 +236,49 @@ def _perceive(rgb, depth, intrinsics, *, segment, mask, depth_mode, footprint, f
         d, filled = perception.fill_depth_holes(d)
     if mask is not None:
         intrinsics.check_shape(np.shape(mask), "mask")
+    try:
+        plane = perception.fit_table_plane(d, intrinsics)
+    except SegmentationError:
+        if chosen:
+            raise
+        plane = None
+    candidates = () if plane is None else perception.find_candidates(d, intrinsics, plane)
+    target, reason = None, ""
+    if chosen:
+        target, reason = perception.choose_target(candidates, target_px=target_px, roi=roi)
+    if mask is not None:
         seg = perception.segment_from_mask(mask)
     else:
+        options = {"footprint": False if depth_mode == "plane" else footprint}
+        if plane is not None and segment != "rgb":
+            options["plane"] = plane  # the same fit segmentation would make
+        if target is not None:
+            options["target"] = target.mask
         seg = perception.segment(rgb, d, intrinsics, method=segment, colour_offset_px=colour_offset_px,
-                                 depth_options={"footprint": False if depth_mode == "plane" else footprint})
+                                 depth_options=options)
+    if target is None:
+        target, reason = _found_target(candidates, seg, mask is not None)
     metric = perception.contour_to_metric(
         seg.contour_px, d, intrinsics, depth_mode=depth_mode, plane=seg.plane, on_table=seg.on_table,
         offset=approach_offset,
     )
-    return seg, metric, filled, d
+    return seg, metric, filled, d, (candidates, target, reason)
+
+
+def _found_target(candidates, seg: Segmentation, user_mask: bool):
+    """The candidate the default segmentation planned on, and why: the largest wholly visible one
+    (depth, the rule of :func:`contourgrasp.perception.choose_target`), else the one the mask or the
+    RGB region overlaps most (None when it overlaps none)."""
+    if not user_mask and seg.method != "rgb":
+        inner = [c for c in candidates if c.in_view]
+        if inner:
+            return perception.choose_target(candidates)
+    overlap = [(int((c.mask & seg.mask).sum()), c) for c in candidates]
+    n, best = max(overlap, key=lambda item: item[0], default=(0, None))
+    what = "the user's mask" if user_mask else f"the region found by the {seg.method} method"
+    if best is None or n == 0:
+        return None, f"{what} (no depth candidate under it)"
+    return best, f"{what}, over candidate {best.label}"
 
 
 def scene_heights(depth, intrinsics: Intrinsics, segmentation: Segmentation, metric: MetricContour) -> HeightMap | None:

@@ -102,6 +102,21 @@ def height_map_summary(heights) -> dict | None:
     }
 
 
+def candidate_to_dict(candidate) -> dict:
+    """The plan file's entry of a :class:`~contourgrasp.perception.Candidate` (not its mask or outline).
+
+    ``{label, area_px, height (m), centroid_px: [u, v], in_view, bbox: [x, y, w, h]}``.
+    """
+    return {
+        "label": candidate.label,
+        "area_px": candidate.area_px,
+        "height": candidate.height,
+        "centroid_px": [float(v) for v in candidate.centroid_px],
+        "in_view": bool(candidate.in_view),
+        "bbox": [int(v) for v in candidate.bbox],
+    }
+
+
 def image_plan_to_dict(result) -> dict:
     """``plan_to_dict`` of the planar plan plus the camera, segmentation and 6-DoF poses of an ImageGraspPlan."""
     data = plan_to_dict(result.plan)
@@ -125,6 +140,8 @@ def image_plan_to_dict(result) -> dict:
         "R_camera_plane": metric.R_camera_plane.tolist(),
         "origin": metric.origin.tolist(),
     }
+    data["objects"] = [candidate_to_dict(c) for c in result.candidates]
+    data["target"] = {"label": None if result.target is None else result.target.label, "reason": result.target_reason}
     data["approach_depth"] = metric.approach_depth
     data["height_map"] = height_map_summary(result.height_map)
     data["T_camera_hand"] = result.T_camera_hand.tolist()

@@ -10,6 +10,8 @@ One module per stage, in the order the pipeline runs them:
   :class:`Segmentation`
 * :mod:`~contourgrasp.perception.segment_rgb` -- the thesis's RGB steps (3.1)
 * :mod:`~contourgrasp.perception.segment_depth` -- the region above the table, its footprint
+* :mod:`~contourgrasp.perception.candidates` -- every region standing on the table
+  (:class:`Candidate`), the target to grasp among them
 * :mod:`~contourgrasp.perception.colour` -- colour-depth registration, flat parts found by colour
 * :mod:`~contourgrasp.perception.segmentation` -- :func:`segment` (the methods and the ``"auto"``
   rule), a user's mask
@@ -27,6 +29,7 @@ from __future__ import annotations
 
 from ..errors import PerceptionError, PerceptionWarning, SegmentationError
 from .camera import Intrinsics, as_depth, backproject, denoised_depth, fill_depth_holes, valid_depth
+from .candidates import TARGET_RULES, Candidate, choose_target, find_candidates
 from .colour import add_flat_parts, colour_offset, register_colour
 from .height_map import HeightMap, height_map
 from .metric import DEPTH_MODES, DepthMode, MetricContour, approach_depth, contour_to_metric
@@ -37,9 +40,9 @@ from .segmentation import SEGMENT_METHODS, SegmentMethod, segment, segment_from_
 from .table import Plane, fit_plane, fit_table_plane
 
 __all__ = [
-    "DEPTH_MODES", "DepthMode", "HeightMap", "Intrinsics", "MetricContour", "PerceptionError", "PerceptionWarning", "Plane",
-    "SEGMENT_METHODS", "SegmentMethod", "Segmentation", "SegmentationError", "add_flat_parts", "approach_depth",
-    "as_depth", "backproject", "colour_offset", "contour_to_metric", "denoised_depth", "fill_depth_holes",
-    "fit_plane", "fit_table_plane", "height_map", "mask_contour", "object_footprint", "register_colour", "segment",
+    "Candidate", "DEPTH_MODES", "DepthMode", "HeightMap", "Intrinsics", "MetricContour", "PerceptionError", "PerceptionWarning", "Plane",
+    "SEGMENT_METHODS", "SegmentMethod", "Segmentation", "SegmentationError", "TARGET_RULES", "add_flat_parts", "approach_depth",
+    "as_depth", "backproject", "choose_target", "colour_offset", "contour_to_metric", "denoised_depth", "fill_depth_holes",
+    "find_candidates", "fit_plane", "fit_table_plane", "height_map", "mask_contour", "object_footprint", "register_colour", "segment",
     "segment_depth", "segment_from_mask", "segment_rgb", "valid_depth",
 ]

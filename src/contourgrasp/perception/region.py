@@ -72,17 +72,35 @@ class Segmentation:
     colour_offset_px: tuple[int, int] | None = None
 
 
-def pick_object(candidates, outside, min_area_px, where):
-    """The largest candidate region touching neither the image border nor ``outside``, holes filled; the warnings."""
+def touching_regions(labels, count, outside) -> np.ndarray:
+    """(count + 1,) bool: which labels of ``labels`` touch the image border or a pixel of ``outside`` (8-neighbour).
+
+    Entry 0 is the background's. Shared by :func:`pick_object` and
+    :func:`~contourgrasp.perception.candidates.find_candidates`.
+    """
+    beyond = np.pad(outside, 1, constant_values=True).astype(np.uint8)
+    near = cv2.dilate(beyond, np.ones((3, 3), np.uint8))[1:-1, 1:-1] > 0
+    touching = np.zeros(count + 1, dtype=bool)
+    touching[labels[near]] = True
+    return touching
+
+
+def pick_object(candidates, outside, min_area_px, where, target=None):
+    """The largest candidate region touching neither the image border nor ``outside``, holes filled; the warnings.
+
+    With ``target`` ((H, W) bool, the mask of a chosen
+    :class:`~contourgrasp.perception.candidates.Candidate`) the region that
+    overlaps it most is taken instead, and no "similar size" warning is given;
+    it must not touch the border or ``outside``.
+    """
     count, labels, stats, _ = cv2.connectedComponentsWithStats(candidates.astype(np.uint8), connectivity=8)
     count -= 1
     if count == 0:
         raise SegmentationError("no-object", f"no object found: no region {where}")
     areas = stats[:, cv2.CC_STAT_AREA]
-    beyond = np.pad(outside, 1, constant_values=True).astype(np.uint8)
-    near = cv2.dilate(beyond, np.ones((3, 3), np.uint8))[1:-1, 1:-1] > 0
-    touching = np.zeros(count + 1, dtype=bool)
-    touching[labels[near]] = True
+    touching = touching_regions(labels, count, outside)
+    if target is not None:
+        return _pick_target(labels, count, touching, np.asarray(target, dtype=bool), where)
     inner = [i for i in np.argsort(-areas[1:], kind="stable") + 1 if not touching[i]]
     largest_touching = int(areas[1:][touching[1:]].max(initial=0))
     if not inner or areas[inner[0]] < min_area_px <= largest_touching:
@@ -101,6 +119,24 @@ def pick_object(candidates, outside, min_area_px, where):
         sizes = ", ".join(f"{areas[i]} px" for i in [inner[0], *similar])
         notes.append(f"{len(similar) + 1} regions {where} of similar size ({sizes}): took the largest")
     return _fill_holes(labels == inner[0]), notes
+
+
+def _pick_target(labels, count, touching, target, where):
+    """:func:`pick_object` with a target mask: the region overlapping it most, holes filled; no notes."""
+    if target.shape != labels.shape:
+        raise SegmentationError("no-object", f"the target mask has shape {target.shape}, the image {labels.shape}")
+    overlap = np.bincount(labels[target], minlength=count + 1)
+    overlap[0] = 0
+    best = int(np.argmax(overlap))
+    if overlap[best] == 0:
+        raise SegmentationError("no-object", f"no object found: no region {where} under the target")
+    if touching[best]:
+        raise SegmentationError(
+            "not-visible",
+            "the object is not completely visible: the target touches the image border "
+            "(thesis 4.1.3 assumes the whole object is in view)",
+        )
+    return _fill_holes(labels == best), []
 
 
 def _fill_holes(region):

@@ -33,6 +33,7 @@ def segment_depth(
     depth_range=SENSOR_RANGE,
     footprint: bool | None = None,
     seed: int = 0,
+    target=None,
 ) -> Segmentation:
     """The region standing above the table, or its footprint on the table.
 
@@ -81,6 +82,11 @@ def segment_depth(
         None: when the camera is tilted (above).
     seed : int
         RANSAC seed.
+    target : (H, W) bool, optional
+        The object to take instead of the largest region: the region that
+        overlaps this mask most (the ``mask`` of a
+        :class:`~contourgrasp.perception.candidates.Candidate` chosen by
+        :func:`~contourgrasp.perception.candidates.choose_target`).
 
     Raises
     ------
@@ -88,11 +94,13 @@ def segment_depth(
         No table plane, nothing above it, the object touches the border, or it is tiny.
     """
     seen, d = seen_above_table(depth, intrinsics, min_height=min_height, plane=plane, fill_holes=fill_holes,
-                                max_hole_px=max_hole_px, min_area_px=min_area_px, depth_range=depth_range, seed=seed)
+                                max_hole_px=max_hole_px, min_area_px=min_area_px, depth_range=depth_range, seed=seed,
+                                target=target)
     return with_footprint(seen, d, intrinsics, footprint, min_area_px)
 
 
-def seen_above_table(depth, intrinsics, *, min_height, plane, fill_holes, max_hole_px, min_area_px, depth_range, seed):
+def seen_above_table(depth, intrinsics, *, min_height, plane, fill_holes, max_hole_px, min_area_px, depth_range, seed,
+                     target=None):
     """:func:`segment_depth` without the footprint: the region seen above the table, and the hole-filled depth."""
     d = as_depth(depth)
     check_intrinsics(intrinsics).check_shape(d.shape, "depth image")
@@ -107,13 +115,44 @@ def seen_above_table(depth, intrinsics, *, min_height, plane, fill_holes, max_ho
         d, filled = fill_depth_holes(d, max_hole_px=max_hole_px)
     if plane is None:
         plane = fit_table_plane(d, intrinsics, depth_range=depth_range, seed=seed)
-    valid = valid_depth(d, depth_range)
-    with np.errstate(invalid="ignore"):
-        above = valid & (heights(d, intrinsics, plane) > min_height)
-    above = cv2.morphologyEx(above.astype(np.uint8), cv2.MORPH_OPEN, np.ones((3, 3), np.uint8)) > 0
-    mask, notes = pick_object(above, _border_connected(~valid), min_area_px,
-                               f"more than {min_height * 1000:.0f} mm above the table")
+    above, dead_band = raised_pixels(d, intrinsics, plane, min_height=min_height, depth_range=depth_range)
+    mask, notes = pick_object(above, dead_band, min_area_px,
+                               f"more than {min_height * 1000:.0f} mm above the table", target=target)
     return make_segmentation("depth", mask, notes, plane=plane, filled_px=filled), d
+
+
+def raised_pixels(depth, intrinsics: Intrinsics, plane: Plane, *, min_height: float = MIN_HEIGHT,
+                  depth_range=SENSOR_RANGE) -> tuple[np.ndarray, np.ndarray]:
+    """The pixels standing on the support surface, and the sensor's dead band.
+
+    Shared by :func:`segment_depth` and
+    :func:`~contourgrasp.perception.candidates.find_candidates`.
+
+    Parameters
+    ----------
+    depth : (H, W) float
+        Depth in meters (holes already filled, if wanted).
+    intrinsics : Intrinsics
+    plane : Plane
+        The support surface.
+    min_height : float
+        Height above ``plane`` (m) from which a pixel stands on it.
+    depth_range : (float, float)
+        Valid depth readings, m.
+
+    Returns
+    -------
+    above : (H, W) bool
+        Valid pixels more than ``min_height`` above the plane, opened with a
+        3 x 3 element to drop speckle.
+    dead_band : (H, W) bool
+        Missing readings connected (8-neighbour) to the image border.
+    """
+    valid = valid_depth(depth, depth_range)
+    with np.errstate(invalid="ignore"):
+        above = valid & (heights(depth, intrinsics, plane) > min_height)
+    above = cv2.morphologyEx(above.astype(np.uint8), cv2.MORPH_OPEN, np.ones((3, 3), np.uint8)) > 0
+    return above, _border_connected(~valid)
 
 
 def with_footprint(seg, depth, intrinsics, footprint, min_area_px) -> Segmentation:

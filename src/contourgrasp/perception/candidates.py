@@ -1,0 +1,266 @@
+"""Every object standing on the support surface, and which one to grasp (issue 17, first part).
+
+:func:`find_candidates` lists every connected region standing on the support
+plane -- the same regions depth segmentation chooses from
+(:func:`~contourgrasp.perception.segment_depth.raised_pixels`), each with its
+outline, area, height and whether it is wholly in view.
+:func:`choose_target` picks one: the candidate under a pixel the user
+clicked, the one filling most of a region of interest, or by default the
+largest wholly visible one -- today's rule (section 4.1.3 of the thesis;
+:func:`~contourgrasp.perception.region.pick_object`), so that a frame with one
+object plans as before. Regions that touch the image border (a bin's wall, the
+robot's own fingers at the image's edge) are listed but never chosen: they
+are not a reason to refuse unless the chosen target touches it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+from scipy import ndimage
+
+from .. import validation
+from ..errors import PerceptionError, SegmentationError
+from ..tolerances import MIN_AREA_PX, MIN_HEIGHT, SENSOR_RANGE
+from .camera import Intrinsics, as_depth, check_intrinsics, valid_depth
+from .region import mask_contour, touching_regions
+from .segment_depth import raised_pixels
+from .table import Plane, heights
+
+#: The target rules of :func:`choose_target`.
+TARGET_RULES: tuple[str, ...] = ("largest", "centre")
+
+
+@dataclass(frozen=True, eq=False)
+class Candidate:
+    """One region standing on the support surface.
+
+    Attributes
+    ----------
+    label : int
+        1, 2, ... in order of decreasing area (ties: image order).
+    mask : (H, W) bool
+        The region's pixels, its holes filled.
+    contour_px : (n, 2) float
+        Its outer outline (u, v), as :attr:`Segmentation.contour_px
+        <contourgrasp.perception.region.Segmentation>`.
+    area_px : int
+        Pixels of the region (before its holes are filled: what stands up).
+    height : float
+        Its highest valid point above the support plane, m.
+    centroid_px : (float, float)
+        Mean pixel (u, v) of the region.
+    bbox : (int, int, int, int)
+        Bounding box (x, y, w, h), pixels.
+    in_view : bool
+        The region touches neither the image border nor the sensor's dead
+        band (missing readings connected to the border): it is wholly seen.
+    """
+
+    label: int
+    mask: np.ndarray
+    contour_px: np.ndarray
+    area_px: int
+    height: float
+    centroid_px: tuple[float, float]
+    bbox: tuple[int, int, int, int]
+    in_view: bool
+
+
+def find_candidates(
+    depth,
+    intrinsics: Intrinsics,
+    plane: Plane,
+    *,
+    min_height: float = MIN_HEIGHT,
+    min_area_px: int = MIN_AREA_PX,
+    depth_range=SENSOR_RANGE,
+) -> tuple[Candidate, ...]:
+    """Every connected region standing on the support surface.
+
+    The pixels more than ``min_height`` above ``plane``, opened against
+    speckle (:func:`~contourgrasp.perception.segment_depth.raised_pixels`,
+    what :func:`~contourgrasp.perception.segment_depth.segment_depth`
+    chooses from), split into 8-connected regions; those of at least
+    ``min_area_px`` pixels are the candidates.
+
+    Parameters
+    ----------
+    depth : (H, W) or (H, W, 1) float
+        Depth in meters, small holes already filled if wanted
+        (:func:`~contourgrasp.perception.fill_depth_holes`).
+    intrinsics : Intrinsics
+        Of the depth image.
+    plane : Plane
+        The support surface (:func:`~contourgrasp.perception.fit_table_plane`).
+    min_height : float
+        Height above the plane (m) from which a pixel stands on it.
+    min_area_px : int
+        Smallest candidate, pixels.
+    depth_range : (float, float)
+        Valid depth readings, m.
+
+    Returns
+    -------
+    tuple of Candidate
+        Largest first; empty when nothing stands on the surface.
+    """
+    d = as_depth(depth)
+    check_intrinsics(intrinsics).check_shape(d.shape, "depth image")
+    if not isinstance(plane, Plane):
+        raise PerceptionError(f"plane must be a contourgrasp.perception.Plane, got {type(plane).__name__}")
+    min_height = validation.positive("min_height", min_height, error=PerceptionError)
+    min_area_px = validation.integer("min_area_px", min_area_px, 1, error=PerceptionError)
+    above, dead_band = raised_pixels(d, intrinsics, plane, min_height=min_height, depth_range=depth_range)
+    count, labels, stats, centroids = cv2.connectedComponentsWithStats(above.astype(np.uint8), connectivity=8)
+    count -= 1
+    if count == 0:
+        return ()
+    touching = touching_regions(labels, count, dead_band)
+    areas = stats[:, cv2.CC_STAT_AREA]
+    valid = valid_depth(d, depth_range)
+    with np.errstate(invalid="ignore"):
+        h = np.where(valid, heights(d, intrinsics, plane), -np.inf)
+    tops = ndimage.maximum(h, labels, index=np.arange(count + 1))
+    order = [i for i in np.argsort(-areas[1:], kind="stable") + 1 if areas[i] >= min_area_px]
+    found = []
+    for label, i in enumerate(order, start=1):
+        x, y, w, hh = (int(v) for v in stats[i, :4])
+        mask = _filled(labels == i, (x, y, w, hh))
+        found.append(Candidate(label, mask, mask_contour(mask), int(areas[i]), float(tops[i]),
+                               (float(centroids[i, 0]), float(centroids[i, 1])), (x, y, w, hh), not bool(touching[i])))
+    return tuple(found)
+
+
+def _filled(region, bbox) -> np.ndarray:
+    """``region`` with its holes filled, on its bounding box padded by one pixel of background."""
+    x, y, w, h = bbox
+    box = np.s_[y:y + h, x:x + w]
+    out = np.zeros(region.shape, dtype=bool)
+    out[box] = ndimage.binary_fill_holes(np.pad(region[box], 1))[1:-1, 1:-1]
+    return out
+
+
+def choose_target(candidates, *, target_px=None, roi=None, rule: str = "largest") -> tuple[Candidate, str]:
+    """The candidate to grasp, and why it was chosen (one line).
+
+    Parameters
+    ----------
+    candidates : sequence of Candidate
+        From :func:`find_candidates`.
+    target_px : (int, int), optional
+        A pixel (u, v): the candidate under it (the user clicked on it).
+    roi : (int, int, int, int), optional
+        A region of interest (x, y, w, h), pixels: the wholly visible
+        candidate with most pixels inside it.
+    rule : {"largest", "centre"}
+        Without ``target_px`` and ``roi``: ``"largest"`` (the default) takes
+        the largest wholly visible candidate -- the rule of every segmentation
+        method (:func:`~contourgrasp.perception.region.pick_object`), so a
+        frame with one object plans as before; ``"centre"`` the wholly visible
+        candidate whose centroid lies nearest the image centre.
+
+    Returns
+    -------
+    candidate : Candidate
+    reason : str
+
+    Raises
+    ------
+    PerceptionError
+        Both ``target_px`` and ``roi``, a malformed pixel or ROI, an unknown rule.
+    SegmentationError
+        One line: nothing stands on the surface (``"no-object"``), no object at
+        ``target_px`` (the message names the nearest candidate's nearest pixel) or in ``roi`` (``"no-object"``), the target -- or every
+        candidate -- touches the image border (``"not-visible"``).
+    """
+    candidates = tuple(candidates)
+    if not all(isinstance(c, Candidate) for c in candidates):
+        raise PerceptionError("candidates must be contourgrasp.perception.Candidate objects (find_candidates)")
+    if target_px is not None and roi is not None:
+        raise PerceptionError("give target_px or roi, not both")
+    rule = validation.choice("rule", rule, TARGET_RULES, error=PerceptionError)
+    shape = candidates[0].mask.shape if candidates else None
+    if target_px is not None:
+        return _at_pixel(candidates, check_pixel(target_px, shape), shape)
+    if roi is not None:
+        return _in_roi(candidates, check_roi(roi, shape))
+    if not candidates:
+        raise SegmentationError("no-object", "no object found: nothing stands on the support surface")
+    inner = [c for c in candidates if c.in_view]
+    if not inner:
+        largest = max(c.area_px for c in candidates)
+        raise SegmentationError(
+            "not-visible",
+            f"the object is not completely visible: every region on the support surface (the largest {largest} px) "
+            f"touches the image border (thesis 4.1.3 assumes the whole object is in view)",
+        )
+    if rule == "largest":
+        return inner[0], f"the largest wholly visible candidate ({inner[0].area_px} px, of {len(candidates)})"
+    centre = np.array([(shape[1] - 1) / 2, (shape[0] - 1) / 2])
+    best = min(inner, key=lambda c: float(np.hypot(*(np.array(c.centroid_px) - centre))))
+    return best, f"the wholly visible candidate nearest the image centre (of {len(candidates)})"
+
+
+def check_pixel(target_px, shape=None) -> tuple[int, int]:
+    """``target_px`` as two integers (u, v), inside an image of ``shape`` (H, W) when given."""
+    values = np.asarray(target_px, dtype=object) if isinstance(target_px, (tuple, list, np.ndarray)) else None
+    if values is None or values.shape != (2,) or not all(
+            isinstance(v, (int, np.integer)) and not isinstance(v, bool) for v in values):
+        raise PerceptionError(f"target_px must be two integers (u, v), got {target_px!r}")
+    u, v = int(values[0]), int(values[1])
+    if shape is not None and not (0 <= u < shape[1] and 0 <= v < shape[0]):
+        raise SegmentationError("no-object", f"pixel ({u}, {v}) is outside the {shape[1]}x{shape[0]} image")
+    return u, v
+
+
+def check_roi(roi, shape=None) -> tuple[int, int, int, int]:
+    """``roi`` as four integers (x, y, w, h), w and h positive, overlapping an image of ``shape`` (H, W) when given."""
+    values = np.asarray(roi, dtype=object) if isinstance(roi, (tuple, list, np.ndarray)) else None
+    if values is None or values.shape != (4,) or not all(
+            isinstance(v, (int, np.integer)) and not isinstance(v, bool) for v in values):
+        raise PerceptionError(f"roi must be four integers (x, y, w, h), got {roi!r}")
+    x, y, w, h = (int(v) for v in values)
+    if w <= 0 or h <= 0:
+        raise PerceptionError(f"roi width and height must be positive, got {w}x{h}")
+    if shape is not None and (x >= shape[1] or y >= shape[0] or x + w <= 0 or y + h <= 0):
+        raise SegmentationError("no-object", f"the ROI ({x}, {y}, {w}, {h}) is outside the {shape[1]}x{shape[0]} image")
+    return x, y, w, h
+
+
+def _at_pixel(candidates, pixel, shape):
+    u, v = pixel
+    for c in candidates:
+        if c.mask[v, u]:
+            if not c.in_view:
+                raise SegmentationError(
+                    "not-visible",
+                    f"the object at pixel ({u}, {v}) is not completely visible: it touches the image border "
+                    f"(thesis 4.1.3 assumes the whole object is in view)",
+                )
+            return c, f"the candidate under pixel ({u}, {v})"
+    if not candidates:
+        raise SegmentationError("no-object", f"no object at pixel ({u}, {v}); nothing stands on the support surface")
+    cu, cv = min((_nearest_pixel(c.mask, u, v) for c in candidates), key=lambda p: (p[0] - u) ** 2 + (p[1] - v) ** 2)
+    raise SegmentationError("no-object", f"no object at pixel ({u}, {v}); the nearest candidate is at ({cu}, {cv})")
+
+
+def _nearest_pixel(mask, u, v) -> tuple[int, int]:
+    """The pixel (u', v') of ``mask`` nearest (u, v)."""
+    rows, cols = np.nonzero(mask)
+    i = int(np.argmin((cols - u) ** 2 + (rows - v) ** 2))
+    return int(cols[i]), int(rows[i])
+
+
+def _in_roi(candidates, roi):
+    x, y, w, h = roi
+    inside = [(int(c.mask[max(y, 0):y + h, max(x, 0):x + w].sum()), c) for c in candidates]
+    visible = [(n, c) for n, c in inside if n > 0 and c.in_view]
+    if not visible:
+        cut = sum(1 for n, c in inside if n > 0)
+        why = f"{cut} region(s) in it touch the image border" if cut else "nothing stands on the support surface there"
+        raise SegmentationError("no-object", f"no candidate in the ROI ({x}, {y}, {w}, {h}): {why}")
+    n, best = max(visible, key=lambda item: item[0])
+    return best, f"the wholly visible candidate with most area in the ROI ({x}, {y}, {w}, {h}): {n} px"

@@ -1,0 +1,210 @@
+"""Candidates standing on the table and the choice of target (issue 17), on synthetic frames and the bundled one."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import contourgrasp as cg
+from contourgrasp.pipeline import plan_frame
+from contourgrasp.cli import main
+from contourgrasp.errors import PerceptionError, SegmentationError
+from contourgrasp.io.camera_file import read_rgbd
+from contourgrasp.io.plan_file import image_plan_to_dict
+from contourgrasp.perception import Candidate, choose_target, find_candidates, fit_table_plane, segment
+
+from perception_scenes import CAMERA, H, W
+
+TABLE = 0.7
+FAST = {"xy_step": 0.03, "yaw_step": math.radians(6)}
+FRAME = Path(__file__).resolve().parents[2] / "examples" / "bar_clamp"
+#: Boxes (x, y, w, h in pixels, height in m): A wholly visible, B smaller and taller, C the largest but cut by
+#: the left border.
+A, B, C = (300, 200, 100, 60, 0.05), (480, 300, 40, 40, 0.08), (0, 80, 80, 120, 0.03)
+
+
+def scene(*boxes, dead_band=None):
+    """Top-down depth of a table at TABLE m with boxes standing on it (each box's top at TABLE - height)."""
+    depth = np.full((H, W), TABLE)
+    for x, y, w, h, height in boxes:
+        depth[y:y + h, x:x + w] = TABLE - height
+    if dead_band is not None:
+        depth[dead_band] = 0.0
+    return depth
+
+
+def candidates(depth):
+    return find_candidates(depth, CAMERA, fit_table_plane(depth, CAMERA))
+
+
+def test_every_region_on_the_table_is_a_candidate_largest_first():
+    found = candidates(scene(A, B, C))
+    assert [c.area_px for c in found] == [80 * 120, 100 * 60, 40 * 40]
+    assert [c.label for c in found] == [1, 2, 3]
+    assert [c.in_view for c in found] == [False, True, True]
+    for c, box in zip(found, (C, A, B), strict=True):
+        x, y, w, h, height = box
+        assert isinstance(c, Candidate)
+        # heights from the rays' points: the plane fit is exact on a flat synthetic table
+        assert c.height == pytest.approx(height, abs=1e-6)
+        assert c.bbox == (x, y, w, h)
+        assert c.centroid_px == pytest.approx((x + (w - 1) / 2, y + (h - 1) / 2))
+        assert c.mask.sum() == w * h and c.contour_px.shape[1] == 2
+
+
+def test_a_region_touching_the_dead_band_is_not_in_view_and_holes_are_filled():
+    band = np.zeros((H, W), dtype=bool)
+    band[:, 620:] = True  # missing readings along the right border
+    ring = scene((560, 100, 60, 60, 0.04), (100, 300, 50, 50, 0.04))
+    ring[310:340, 115:135] = TABLE  # a hole through the second box
+    ring[band] = 0.0
+    found = candidates(ring)
+    assert [c.in_view for c in found] == [False, True]
+    holed = next(c for c in found if c.bbox[0] == 100)
+    assert holed.area_px == 2500 - 600 and holed.mask.sum() == 2500
+
+
+def test_nothing_on_the_table_gives_no_candidates():
+    assert candidates(scene()) == ()
+    with pytest.raises(SegmentationError, match="nothing stands on the support surface") as err:
+        choose_target(())
+    assert err.value.kind == "no-object"
+
+
+def test_default_target_is_the_largest_wholly_visible_candidate():
+    found = candidates(scene(A, B, C))
+    target, reason = choose_target(found)
+    assert target.bbox[:2] == A[:2] and "largest wholly visible" in reason
+    centre, why = choose_target(found, rule="centre")
+    assert centre.bbox[:2] == A[:2] and "centre" in why  # A's centroid (349.5, 229.5) is nearer (319.5, 239.5)
+    with pytest.raises(PerceptionError, match="rule"):
+        choose_target(found, rule="nearest")
+
+
+def test_default_target_equals_todays_depth_segmentation():
+    depth = scene(A, B, C)
+    target, _ = choose_target(candidates(depth))
+    seg = segment(None, depth, CAMERA, method="depth")
+    np.testing.assert_array_equal(seg.mask, target.mask)
+
+
+def test_every_candidate_touching_the_border_is_refused_as_not_visible():
+    with pytest.raises(SegmentationError, match="not completely visible") as err:
+        choose_target(candidates(scene(C, (600, 0, 40, 40, 0.05))))
+    assert err.value.kind == "not-visible" and "\n" not in str(err.value)
+
+
+def test_target_by_pixel():
+    found = candidates(scene(A, B, C))
+    target, reason = choose_target(found, target_px=(490, 310))
+    assert target.bbox[:2] == B[:2] and reason == "the candidate under pixel (490, 310)"
+    with pytest.raises(SegmentationError, match=r"^no object at pixel \(450, 100\); the nearest candidate is at "
+                                                r"\(399, 200\)$"):
+        choose_target(found, target_px=(450, 100))
+    with pytest.raises(SegmentationError, match=r"the object at pixel \(10, 100\) is not completely visible") as err:
+        choose_target(found, target_px=(10, 100))
+    assert err.value.kind == "not-visible"
+    with pytest.raises(SegmentationError, match=r"pixel \(640, 10\) is outside the 640x480 image"):
+        choose_target(found, target_px=(640, 10))
+    with pytest.raises(PerceptionError, match="two integers"):
+        choose_target(found, target_px=(1.5, 2))
+    with pytest.raises(PerceptionError, match="not both"):
+        choose_target(found, target_px=(1, 2), roi=(0, 0, 5, 5))
+
+
+def test_target_by_roi():
+    found = candidates(scene(A, B, C))
+    # covers all of C, a strip of A and a corner of B: the wholly visible one with most area in it is A
+    target, reason = choose_target(found, roi=(0, 0, 310, 480))
+    assert target.bbox[:2] == A[:2] and reason.endswith(": 600 px")  # A's columns 300-309
+    target, _ = choose_target(found, roi=(380, 150, 200, 200))
+    assert target.bbox[:2] == B[:2]  # B 1600 px inside, A 20 x 60 = 1200 px
+    with pytest.raises(SegmentationError, match=r"^no candidate in the ROI \(0, 50, 60, 60\): 1 region\(s\) in it "
+                                                r"touch the image border$") as err:
+        choose_target(found, roi=(0, 50, 60, 60))
+    with pytest.raises(SegmentationError, match="nothing stands on the support surface there"):
+        choose_target(found, roi=(200, 400, 50, 50))
+    with pytest.raises(PerceptionError, match="positive"):
+        choose_target(found, roi=(0, 0, 0, 5))
+    with pytest.raises(SegmentationError, match="outside the 640x480 image"):
+        choose_target(found, roi=(700, 0, 5, 5))
+    assert err.value.kind == "no-object"
+
+
+def test_plan_frame_plans_on_the_chosen_target_and_lists_the_candidates():
+    depth = scene(A, B, C)
+    hand = cg.load_hand("three-finger")
+    default = plan_frame(None, depth, CAMERA, hand, **FAST)
+    chosen = plan_frame(None, depth, CAMERA, hand, target_px=(490, 310), **FAST)
+    assert default.target.bbox[:2] == A[:2] and chosen.target.bbox[:2] == B[:2]
+    np.testing.assert_array_equal(chosen.segmentation.mask, chosen.target.mask)
+    data = image_plan_to_dict(chosen)
+    assert [o["in_view"] for o in data["objects"]] == [False, True, True]
+    assert data["objects"][2] == {"label": 3, "area_px": 1600, "height": pytest.approx(0.08, abs=1e-6),
+                                  "centroid_px": [499.5, 319.5], "in_view": True, "bbox": [480, 300, 40, 40]}
+    assert data["target"] == {"label": 3, "reason": "the candidate under pixel (490, 310)"}
+    by_roi = plan_frame(None, depth, CAMERA, hand, roi=(470, 290, 20, 20), **FAST)
+    np.testing.assert_allclose(by_roi.T_camera_hand, chosen.T_camera_hand)
+    with pytest.raises(SegmentationError, match="not completely visible"):
+        plan_frame(None, depth, CAMERA, hand, target_px=(10, 100), **FAST)
+    with pytest.raises(PerceptionError, match="not with a mask"):
+        plan_frame(None, depth, CAMERA, hand, mask=default.segmentation.mask, target_px=(490, 310))
+
+
+def test_the_bundled_frame_lists_the_grippers_fingers_as_candidates_not_in_view():
+    frame = read_rgbd(FRAME / "color_0.png", FRAME / "depth_0.npy", FRAME / "primesense_overhead_color.intr")
+    result = cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, "three-finger", **FAST)
+    fingers = [c for c in result.candidates if not c.in_view]
+    assert len(fingers) == 2 and all(c.bbox[1] + c.bbox[3] > 0.75 * frame.intrinsics.height for c in fingers)
+    assert result.target.in_view and result.target.label == 3
+    # the object planned on is the one today's segmentation finds
+    d, _ = cg.perception.fill_depth_holes(frame.depth)
+    today = segment(frame.rgb, d, frame.intrinsics)
+    np.testing.assert_array_equal(result.segmentation.mask, today.mask)
+    v, u = np.argwhere(result.target.mask)[len(np.argwhere(result.target.mask)) // 2]
+    clicked = cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, "three-finger", target_px=(int(u), int(v)),
+                            **FAST)
+    np.testing.assert_allclose(clicked.T_camera_hand, result.T_camera_hand)
+
+
+#: ``contourgrasp plan`` on examples/bar_clamp with the default hand and planner, on main before issue 17.
+MAIN_POSE = {"x": -0.12883457293878184, "y": -0.018931441854729582, "yaw": 4.60766922526503}
+
+
+def _plan(tmp_path, capsys, *extra):
+    out = tmp_path / "plan.json"
+    code = main(["plan", "--rgb", str(FRAME / "color_0.png"), "--depth", str(FRAME / "depth_0.npy"),
+                 "--intrinsics", str(FRAME / "primesense_overhead_color.intr"), "--out", str(out), *extra])
+    return code, out, capsys.readouterr()
+
+
+def test_cli_plan_on_the_bundled_frame_is_unchanged_and_reports_objects(tmp_path, capsys):
+    import json
+
+    code, out, _ = _plan(tmp_path, capsys)
+    assert code == 0
+    data = json.loads(out.read_text())
+    assert data["pose"] == pytest.approx(MAIN_POSE, abs=1e-9)
+    assert [o["in_view"] for o in data["objects"]] == [False, False, True]
+    assert data["target"]["label"] == 3 and "largest wholly visible" in data["target"]["reason"]
+
+
+@pytest.mark.parametrize(("args", "message"), [
+    (["--target", "1,2,3"], "--target: must be 2 integers U,V"),
+    (["--target", "a,b"], "--target: must be 2 integers U,V"),
+    (["--roi", "1,2,0,4"], "--roi: W and H must be positive"),
+    (["--roi", "1,2,3"], "--roi: must be 4 integers X,Y,W,H"),
+    (["--target", "1,2", "--roi", "0,0,5,5"], "not allowed with argument"),
+    (["--target", "640,10"], "error: pixel (640, 10) is outside the 640x480 image"),
+    (["--roi", "700,0,10,10"], "outside the 640x480 image"),
+    (["--target", "320,50"], "error: no object at pixel (320, 50); the nearest candidate is at"),
+    (["--target", "176,422"], "is not completely visible"),
+    (["--roi", "0,0,100,100"], "error: no candidate in the ROI (0, 0, 100, 100)"),
+])
+def test_cli_plan_refuses_bad_targets_in_one_line_writing_nothing(tmp_path, capsys, args, message):
+    code, out, (stdout, stderr) = _plan(tmp_path, capsys, *args)
+    assert code == 2 and not out.exists()
+    assert message in stderr and len(stderr.strip().splitlines()) == 1
