@@ -29,7 +29,7 @@ from scipy.spatial.transform import Rotation
 from . import perception, validation
 from .errors import HandError, PerceptionError, PlannerError, SegmentationError
 from .hand import Hand
-from .perception import HeightMap, Intrinsics, MetricContour, Segmentation
+from .perception import HeightMap, Intrinsics, MetricContour, Plane, Segmentation
 from .perception.camera import check_intrinsics
 from .synthesis import GraspPlan, search
 from .tolerances import APPROACH_OFFSET, HOMOGENEOUS_ROW, MAX_APPROACH_OFFSET, MAX_STANDOFF, ROTATION_TOLERANCE
@@ -177,11 +177,11 @@ def plan_frame(
         T_base_camera = validation.rigid_transform("T_base_camera", T_base_camera, error=PerceptionError,
                                                    rotation_tolerance=ROTATION_TOLERANCE,
                                                    row_tolerance=HOMOGENEOUS_ROW)
-    seg, metric, filled, d, scene = _perceive(rgb, depth, intrinsics, segment=segment, mask=mask, depth_mode=depth_mode,
+    seg, metric, filled, d, table, scene = _perceive(rgb, depth, intrinsics, segment=segment, mask=mask, depth_mode=depth_mode,
                                               footprint=footprint, fill_holes=fill_holes,
                                               colour_offset_px=colour_offset_px, approach_offset=approach_offset,
                                               target_px=target_px, roi=roi)
-    heights = scene_heights(d, intrinsics, seg, metric)
+    heights = scene_heights(d, intrinsics, seg, metric, plane=table)
     plan = search(metric.contour_xy, hand, **synthesis_options)
     T_camera_hand = hand_pose(metric, plan.pose, metric.approach_depth)
     T_camera_pregrasp = T_camera_hand.copy()
@@ -215,7 +215,9 @@ def perceive(
 
 def _perceive(rgb, depth, intrinsics, *, segment, mask, depth_mode, footprint, fill_holes, colour_offset_px,
               approach_offset, target_px=None, roi=None):
-    """:func:`perceive`, the depth image it worked on (holes filled), and (candidates, target, reason)."""
+    """:func:`perceive`, the depth image it worked on (holes filled), the table plane (None if there is
+    none: fitted once here and shared by segmentation, the metric contour and the height map), and
+    (candidates, target, reason)."""
     _check_options(intrinsics, segment, depth_mode, footprint, fill_holes, colour_offset_px, approach_offset)
     chosen = target_px is not None or roi is not None
     if target_px is not None and roi is not None:
@@ -259,10 +261,10 @@ def _perceive(rgb, depth, intrinsics, *, segment, mask, depth_mode, footprint, f
     if target is None:
         target, reason = _found_target(candidates, seg, mask is not None)
     metric = perception.contour_to_metric(
-        seg.contour_px, d, intrinsics, depth_mode=depth_mode, plane=seg.plane, on_table=seg.on_table,
-        offset=approach_offset,
+        seg.contour_px, d, intrinsics, depth_mode=depth_mode, plane=plane if seg.plane is None else seg.plane,
+        on_table=seg.on_table, offset=approach_offset,
     )
-    return seg, metric, filled, d, (candidates, target, reason)
+    return seg, metric, filled, d, plane, (candidates, target, reason)
 
 
 def _found_target(candidates, seg: Segmentation, user_mask: bool):
@@ -281,12 +283,14 @@ def _found_target(candidates, seg: Segmentation, user_mask: bool):
     return best, f"{what}, over candidate {best.label}"
 
 
-def scene_heights(depth, intrinsics: Intrinsics, segmentation: Segmentation, metric: MetricContour) -> HeightMap | None:
+def scene_heights(depth, intrinsics: Intrinsics, segmentation: Segmentation, metric: MetricContour, *,
+                  plane: Plane | None = None) -> HeightMap | None:
     """The height map of :func:`plan_frame` (:func:`contourgrasp.perception.height_map`, default cell and margin).
 
-    The table is the segmentation's plane; a user's mask or the RGB method brings none, and it is
-    fitted then (the same fit :func:`contourgrasp.perception.contour_to_metric` made). None when
-    there is no table plane in the depth image.
+    The table is ``plane`` when given (:func:`plan_frame` fits it once), else the segmentation's
+    plane; a user's mask or the RGB method brings none, and it is fitted then (the same fit
+    :func:`contourgrasp.perception.contour_to_metric` makes). None when there is no table plane in
+    the depth image.
 
     Parameters
     ----------
@@ -300,7 +304,7 @@ def scene_heights(depth, intrinsics: Intrinsics, segmentation: Segmentation, met
     -------
     HeightMap or None
     """
-    plane = segmentation.plane
+    plane = segmentation.plane if plane is None else plane
     if plane is None:
         if metric.tilt is None:  # contour_to_metric found no table either
             return None
