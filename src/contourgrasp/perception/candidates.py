@@ -123,13 +123,14 @@ def find_candidates(
     valid = valid_depth(d, depth_range)
     with np.errstate(invalid="ignore"):
         h = np.where(valid, heights(d, intrinsics, plane), -np.inf)
-    tops = ndimage.maximum(h, labels, index=np.arange(count + 1))
     order = [i for i in np.argsort(-areas[1:], kind="stable") + 1 if areas[i] >= min_area_px]
     found = []
     for label, i in enumerate(order, start=1):
         x, y, w, hh = (int(v) for v in stats[i, :4])
+        box = np.s_[y:y + hh, x:x + w]  # a region's top and fill on its box only: speckle makes thousands of labels
+        top = float(h[box][labels[box] == i].max())
         mask = _filled(labels == i, (x, y, w, hh))
-        found.append(Candidate(label, mask, mask_contour(mask), int(areas[i]), float(tops[i]),
+        found.append(Candidate(label, mask, mask_contour(mask), int(areas[i]), top,
                                (float(centroids[i, 0]), float(centroids[i, 1])), (x, y, w, hh), not bool(touching[i])))
     return tuple(found)
 
