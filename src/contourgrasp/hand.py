@@ -51,6 +51,7 @@ import numpy as np
 
 from . import tolerances as tol
 from . import validation as check
+from .contour.polygon import signed_area
 from .errors import HandError
 
 
@@ -372,7 +373,7 @@ class Palm:
         if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 3 or not np.isfinite(pts).all():
             raise HandError(f"palm outline must be at least 3 finite (x, y) points, got {self.outline!r}")
         check.at_most("palm |outline|", float(np.abs(pts).max()), tol.MAX_HAND_SIZE, " m", error=HandError)
-        if abs(polygon_area(pts)) <= tol.MIN_AREA:
+        if abs(signed_area(pts)) <= tol.MIN_AREA:
             raise HandError("palm outline has no area")
         check.bounded("palm thickness", self.thickness, tol.MAX_HAND_SIZE, " m", strict=True, error=HandError)
         object.__setattr__(self, "outline", tuple((float(x), float(y)) for x, y in pts))
@@ -382,12 +383,6 @@ class Palm:
     def points(self) -> np.ndarray:
         """(k, 2) float: the outline."""
         return np.array(self.outline)
-
-
-def polygon_area(points) -> float:
-    """Signed area (m^2) of the polygon (k, 2): positive counter-clockwise in x-right, y-up axes."""
-    x, y = np.asarray(points, dtype=float).T
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
 
 
 def chain_angles(chain: FingerChain, s) -> np.ndarray:

@@ -13,8 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .hand_model import HandDesign
 from ..errors import SimulationError
+from ..hand import polyline_distance
+from .hand_model import HandDesign
 from .scene import build_scene
 
 #: Palm height for free-space closing: fingertips far above the table and the object.
@@ -55,14 +56,6 @@ def fingertip_paths(hand="five-finger-linear", *, timing: str = "thesis", design
     return {f.name: paths[:, i] for i, f in enumerate(scene.hand.fingers)}
 
 
-def segment_distance(points, start, end) -> np.ndarray:
-    """(k,) float: distance of each point (k, 2) to the segment start-end."""
-    points, start, end = (np.asarray(a, dtype=float) for a in (points, start, end))
-    d = end - start
-    t = np.clip((points - start) @ d / (d @ d), 0.0, 1.0)
-    return np.linalg.norm(points - (start + t[:, None] * d), axis=1)
-
-
 def fingertip_path_error(hand="five-finger-linear", **kwargs) -> dict[str, float]:
     """Per finger, the largest distance (mm) between its projected free-space path and the preset's segment.
 
@@ -72,4 +65,4 @@ def fingertip_path_error(hand="five-finger-linear", **kwargs) -> dict[str, float
 
     preset = load_hand(hand)
     paths = fingertip_paths(preset, **kwargs)
-    return {f.name: 1000.0 * float(segment_distance(paths[f.name], f.start, f.end).max()) for f in preset.fingers}
+    return {f.name: 1000.0 * float(polyline_distance(paths[f.name], [f.start, f.end]).max()) for f in preset.fingers}
