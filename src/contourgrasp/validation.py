@@ -159,13 +159,20 @@ def depth_range(name: str, value, *, error: type[InputError] = InputError) -> tu
     return lo, hi
 
 
+def integers(name: str, value, fields: str, *, error: type[InputError] = InputError) -> tuple[int, ...]:
+    """As many integers (no bools) as ``fields`` names, e.g. ``"u, v"`` or ``"x, y, w, h"``; a tuple, list or array."""
+    n = len(fields.split(","))
+    values = np.asarray(value, dtype=object) if isinstance(value, (tuple, list, np.ndarray)) else None
+    if values is None or values.shape != (n,) or not all(
+            isinstance(v, (int, np.integer)) and not isinstance(v, bool) for v in values):
+        count = {2: "two", 3: "three", 4: "four"}.get(n, str(n))
+        raise error(f"{name} must be {count} integers ({fields}), got {value!r}")
+    return tuple(int(v) for v in values)
+
+
 def pixel_offset(name: str, value, *, error: type[InputError] = InputError) -> tuple[int, int]:
     """Two integers (dx, dy), pixels."""
-    values = np.asarray(value, dtype=object) if isinstance(value, (tuple, list, np.ndarray)) else None
-    if values is None or values.shape != (2,) or not all(
-            isinstance(v, (int, np.integer)) and not isinstance(v, bool) for v in values):
-        raise error(f"{name} must be two integers (dx, dy), got {value!r}")
-    return int(values[0]), int(values[1])
+    return integers(name, value, "dx, dy", error=error)
 
 
 def pixel_contour(name: str, value, shape, *, error: type[InputError] = InputError) -> np.ndarray:

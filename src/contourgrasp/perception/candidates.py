@@ -207,11 +207,7 @@ def choose_target(candidates, *, target_px=None, roi=None, rule: str = "largest"
 
 def check_pixel(target_px, shape=None) -> tuple[int, int]:
     """``target_px`` as two integers (u, v), inside an image of ``shape`` (H, W) when given."""
-    values = np.asarray(target_px, dtype=object) if isinstance(target_px, (tuple, list, np.ndarray)) else None
-    if values is None or values.shape != (2,) or not all(
-            isinstance(v, (int, np.integer)) and not isinstance(v, bool) for v in values):
-        raise PerceptionError(f"target_px must be two integers (u, v), got {target_px!r}")
-    u, v = int(values[0]), int(values[1])
+    u, v = validation.integers("target_px", target_px, "u, v", error=PerceptionError)
     if shape is not None and not (0 <= u < shape[1] and 0 <= v < shape[0]):
         raise SegmentationError("no-object", f"pixel ({u}, {v}) is outside the {shape[1]}x{shape[0]} image")
     return u, v
@@ -219,11 +215,7 @@ def check_pixel(target_px, shape=None) -> tuple[int, int]:
 
 def check_roi(roi, shape=None) -> tuple[int, int, int, int]:
     """``roi`` as four integers (x, y, w, h), w and h positive, overlapping an image of ``shape`` (H, W) when given."""
-    values = np.asarray(roi, dtype=object) if isinstance(roi, (tuple, list, np.ndarray)) else None
-    if values is None or values.shape != (4,) or not all(
-            isinstance(v, (int, np.integer)) and not isinstance(v, bool) for v in values):
-        raise PerceptionError(f"roi must be four integers (x, y, w, h), got {roi!r}")
-    x, y, w, h = (int(v) for v in values)
+    x, y, w, h = validation.integers("roi", roi, "x, y, w, h", error=PerceptionError)
     if w <= 0 or h <= 0:
         raise PerceptionError(f"roi width and height must be positive, got {w}x{h}")
     if shape is not None and (x >= shape[1] or y >= shape[0] or x + w <= 0 or y + h <= 0):
