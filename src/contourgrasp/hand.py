@@ -620,6 +620,23 @@ class Hand:
         return self.chains is not None
 
     @property
+    def open_tip_depth(self) -> float | None:
+        """Depth of the open hand's lowest fingertip (tip centre) below the palm's underside, m; None in 2-D."""
+        return None if self.chains is None else max(float(chain_tip(c, 0.0)[0, 2]) for c in self.chains)
+
+    @property
+    def closing_tip_depth(self) -> float | None:
+        """Deepest any fingertip (tip centre) goes below the palm's underside while closing, m; None in 2-D.
+
+        Sampled at ``tolerances.CHAIN_SAMPLES`` closing progresses: a finger leaning outward swings its
+        tip lower on the way in before it rises again.
+        """
+        if self.chains is None:
+            return None
+        s = np.linspace(0.0, 1.0, tol.CHAIN_SAMPLES)
+        return max(float(chain_tip(c, s)[:, 2].max()) for c in self.chains)
+
+    @property
     def starts(self) -> np.ndarray:
         """(n_fingers, 2) float: open-hand fingertips, hand frame."""
         return np.array([f.start for f in self.fingers])

@@ -31,7 +31,8 @@ from .errors import HandError, PerceptionError, PlannerError, SegmentationError
 from .hand import Hand
 from .perception import HeightMap, Intrinsics, MetricContour, Plane, Segmentation
 from .perception.camera import check_intrinsics
-from .synthesis import GraspPlan, search
+from .synthesis import Descent, GraspPlan, search
+from .synthesis.grasp_height import grasp_height as choose_grasp_height
 from .tolerances import APPROACH_OFFSET, HOMOGENEOUS_ROW, MAX_APPROACH_OFFSET, MAX_STANDOFF, ROTATION_TOLERANCE
 
 SEGMENT_CHOICES = perception.SEGMENT_METHODS
@@ -67,6 +68,10 @@ class ImageGraspPlan:
         object did not come from the depth candidates (the RGB method found it) and overlaps none.
     target_reason : str
         Why that object was planned on, one line.
+    grasp_height : float or None
+        Height above the table of the open hand's lowest fingertip at ``T_camera_hand``, m, when
+        the planner chose it (``plan_frame(descent=...)`` or ``grasp_height=...``); None when the
+        executor chooses how deep to go.
     """
 
     plan: GraspPlan
@@ -81,6 +86,7 @@ class ImageGraspPlan:
     candidates: tuple = ()
     target: perception.Candidate | None = None
     target_reason: str = ""
+    grasp_height: float | None = None
 
     @property
     def quaternion_xyzw(self) -> np.ndarray:
@@ -105,6 +111,8 @@ def plan_frame(
     T_base_camera=None,
     target_px=None,
     roi=None,
+    descent: bool = False,
+    grasp_height: str | float | None = None,
     **synthesis_options,
 ) -> ImageGraspPlan:
     """Plan a grasp on one RGB-D frame with a :class:`~contourgrasp.hand.Hand`.
@@ -154,6 +162,17 @@ def plan_frame(
         standing on the table, as always (:func:`contourgrasp.perception.choose_target`);
         regions touching the image border are listed in ``candidates`` but never chosen.
         Both need depth segmentation (not ``mask`` or ``segment="rgb"``).
+    descent : bool
+        Plan with the hand's 3-D bodies: a pose is feasible only if the open hand descends to the
+        grasp height without any finger's body or the palm passing below the scene's height map
+        (:class:`~contourgrasp.synthesis.Descent`). Needs a 3-D hand and a table plane; without
+        them the plan is 2-D and says so in its notes.
+    grasp_height : {"clearance", "auto"} or float, optional
+        The height above the table of the open hand's lowest fingertip at the grasp
+        (:func:`~contourgrasp.synthesis.grasp_height.grasp_height`); with ``descent`` and None,
+        ``"clearance"``. Planned, it is the plan's ``grasp_height`` and ``T_camera_hand`` is the
+        hand at that height; None without ``descent``: ``T_camera_hand`` is at the approach
+        depth and the executor chooses how deep to go, as in the thesis.
     **synthesis_options
         Keyword options of :func:`contourgrasp.synthesis.search`.
 
@@ -182,13 +201,37 @@ def plan_frame(
                                               colour_offset_px=colour_offset_px, approach_offset=approach_offset,
                                               target_px=target_px, roi=roi)
     heights = scene_heights(d, intrinsics, seg, metric, plane=table)
-    plan = search(metric.contour_xy, hand, **synthesis_options)
-    T_camera_hand = hand_pose(metric, plan.pose, metric.approach_depth)
+    asked = _grasp_height(hand, heights, descent, grasp_height)
+    spec = Descent(heights, *asked) if descent and asked is not None else None
+    plan = search(metric.contour_xy, hand, descent=spec, **synthesis_options)
+    tip_height = None if asked is None else asked[0] if plan.descent is None else float(plan.descent.tip_height[0])
+    depth_at = (metric.approach_depth if tip_height is None
+                else _palm_depth(metric, heights, hand, plan.pose, tip_height))
+    T_camera_hand = hand_pose(metric, plan.pose, depth_at)
     T_camera_pregrasp = T_camera_hand.copy()
     T_camera_pregrasp[:3, 3] -= standoff * T_camera_hand[:3, 2]
     T_base_hand = None if T_base_camera is None else T_base_camera @ T_camera_hand
     return ImageGraspPlan(plan, seg, metric, intrinsics, T_camera_hand, T_camera_pregrasp, T_base_hand, filled,
-                          heights, *scene)
+                          heights, *scene, grasp_height=tip_height)
+
+
+def _grasp_height(hand: Hand, heights: HeightMap | None, descent, grasp_height) -> float | None:
+    """The grasp height asked for and the highest accepted, for :func:`plan_frame`'s options; None: not
+    planned (a 2-D hand, no table)."""
+    descent = validation.flag("descent", descent, error=PlannerError)
+    if grasp_height is None and not descent:
+        return None
+    if not hand.is_3d or heights is None:
+        return None
+    return choose_grasp_height(hand, heights, "clearance" if grasp_height is None else grasp_height)
+
+
+def _palm_depth(metric: MetricContour, heights: HeightMap, hand: Hand, pose, tip_height: float) -> float:
+    """Depth along the approach axis of the palm's underside at ``pose`` when the open tips are ``tip_height`` up."""
+    x, y = pose[:2]
+    n, offset = heights.table_normal, heights.table_offset
+    z = (tip_height + hand.open_tip_depth - offset - n[0] * x - n[1] * y) / n[2]
+    return float(z + metric.R_camera_plane[:, 2] @ metric.origin)
 
 
 def perceive(

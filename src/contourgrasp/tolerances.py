@@ -313,3 +313,25 @@ MAX_PLAUSIBLE_DEPTH = 20.0
 
 #: A median depth below this (m) is closer than any depth camera measures.
 MIN_PLAUSIBLE_DEPTH = 0.02
+
+# --- the 3-D hand in the search (issue 16) ---
+
+#: Descent check in the search: the clearance (m) every body of the open hand keeps over the height map.
+#: 3 mm covers the map's discretisation (a body moved by half a 2 mm cell's diagonal, 1.4 mm) and the
+#: sensor's noise on a surface's height (about 1 mm at the working distance).
+DESCENT_MARGIN = 0.003
+
+#: Descent check in the search: candidate poses checked at once, in increasing cost, and the most checked
+#: in one search before it gives up (about 0.7 ms a pose: at most about 3 s).
+DESCENT_BATCH = 32
+MAX_DESCENT_POSES = 4096
+
+#: Grasp height rule "clearance" (synthesis.grasp_height): the open fingertips' surfaces this far (m) above the
+#: table, and the palm's underside at least this far above the object's top -- the simulated execution's own
+#: rule before the planner chose the height (sim.trial.Execution's tip_clearance and palm_clearance).
+GRASP_TIP_CLEARANCE = 0.003
+GRASP_PALM_CLEARANCE = 0.02
+
+#: Grasp height rule "auto": the highest grasp height accepted, as a fraction of the object's height.
+#: Chosen on ycb-train (README, "3-D hand").
+GRASP_HEIGHT_FRACTION = 0.5

@@ -77,7 +77,7 @@ def test_placement_is_seeded_and_inside_the_workspace():
 def test_planner_finds_the_can(can_scene):
     rgb, depth = render(can_scene, noise=True, seed=1)
     hand = contourgrasp.load_hand("five-finger-linear")
-    transform, approach = make_planner("paper", hand)(rgb, depth, can_scene.camera.intrinsics)
+    transform, approach, height = make_planner("paper", hand)(rgb, depth, can_scene.camera.intrinsics)
     x, y, yaw = hand_pose_from_matrix(transform)
     grasp_centre = contourgrasp.hand.to_image(hand.grasp_centre[None], (x, y, yaw))[0]
     can_centre = can_scene.camera.from_world(can_scene.object_com())[:2]

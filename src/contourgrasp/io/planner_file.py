@@ -24,6 +24,8 @@ which is the thesis's setting)::
     friction = 0.5
     require_closure = false
     quality_gain = 0.0
+    descent = false              # the open 3-D hand's descent onto the height map (synthesis.Descent)
+    grasp_height = "clearance"   # or "auto", or a height in m (synthesis.grasp_height)
 
 Unknown keys, wrong types and impossible values are refused with
 :class:`PlannerFileError` naming the file and the field; so is a file that is not UTF-8 text or
@@ -44,8 +46,10 @@ from ..errors import PlannerError, PlannerFileError
 from . import _toml_files
 
 _PRESET_DIR = "data/planners"
-#: Options that belong to perception (the rest are :func:`contourgrasp.synthesis.search`'s).
+#: Options that belong to perception, and to planning in the scene's 3-D (the rest are
+#: :func:`contourgrasp.synthesis.search`'s).
 PERCEPTION_OPTIONS = ("depth_mode", "footprint")
+SCENE_OPTIONS = ("descent", "grasp_height")
 
 Positive = Annotated[float, Field(gt=0, le=tol.MAX_SEARCH_LENGTH, allow_inf_nan=False)]
 Distance = Annotated[float, Field(ge=0, le=tol.MAX_SEARCH_LENGTH, allow_inf_nan=False)]
@@ -71,6 +75,9 @@ class _PlannerSchema(BaseModel):
     friction: Annotated[float, Field(ge=0, le=tol.MAX_FRICTION, allow_inf_nan=False)] | None = None
     require_closure: bool | None = None
     quality_gain: NonNegative | None = None
+    descent: bool | None = None
+    grasp_height: (Literal["clearance", "auto"]
+                   | Annotated[float, Field(ge=0, le=tol.MAX_HAND_SIZE, allow_inf_nan=False)] | None) = None
 
     @model_validator(mode="after")
     def _grid_size(self):
@@ -114,7 +121,7 @@ class Planner:
 
 def synthesis_options(options: dict) -> dict:
     """The options of :func:`contourgrasp.pipeline.plan_frame` that :func:`contourgrasp.synthesis.search` takes."""
-    return {k: v for k, v in options.items() if k not in PERCEPTION_OPTIONS}
+    return {k: v for k, v in options.items() if k not in PERCEPTION_OPTIONS + SCENE_OPTIONS}
 
 
 def planner_names() -> list[str]:

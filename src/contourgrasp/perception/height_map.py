@@ -209,8 +209,16 @@ class HeightMap:
         Returns
         -------
         (ny, nx) float
-            No NaN; +inf outside the view.
+            No NaN; +inf outside the view. Computed once per map and read-only.
         """
+        cached = self.__dict__.get("_conservative")
+        if cached is None:
+            cached = self._conservative()
+            cached.flags.writeable = False
+            object.__setattr__(self, "_conservative", cached)
+        return cached
+
+    def _conservative(self) -> np.ndarray:
         out = self.heights.copy()
         seen = self.seen
         if seen.all():

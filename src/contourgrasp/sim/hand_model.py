@@ -239,6 +239,11 @@ class HandModel:
     palm_box: tuple[tuple[float, float], tuple[float, float]]
 
     @property
+    def open_tip_depth(self) -> float:
+        """Depth of the open hand's lowest fingertip centre below the palm's underside, m."""
+        return self.hand.open_tip_depth
+
+    @property
     def finger_names(self) -> tuple[str, ...]:
         return tuple(f.name for f in self.fingers)
 
@@ -362,8 +367,7 @@ def build_hand(hand: Hand, *, design: HandDesign = HandDesign(), timing: str = "
         fingers.append(FingerModel(name=finger.name, start=finger.start, travel=finger.travel, chain=chain,
                                    moment_arms=(strength * design.moment_arms[0], strength * design.moment_arms[1]),
                                    timing=schedule.get(finger.name, schedule["default"])))
-    tip_depth = max(float(chain_tip(c, np.linspace(0.0, 1.0, REACH_SAMPLES))[:, 2].max()) for c in hand.chains)
-    return HandModel(hand=hand, design=design, fingers=tuple(fingers), tip_depth=tip_depth,
+    return HandModel(hand=hand, design=design, fingers=tuple(fingers), tip_depth=hand.closing_tip_depth,
                      palm_box=_palm_box(hand))
 
 

@@ -86,6 +86,8 @@ class PlannedGrasp:
     camera : contourgrasp.perception.Intrinsics
     plan : GraspPlan or None
         The synthesis result (None for a baseline).
+    grasp_height : float or None
+        The planned height of the open tips above the table (None: the execution's own rule).
     """
 
     pose: np.ndarray
@@ -95,6 +97,7 @@ class PlannedGrasp:
     metric: perception.MetricContour
     camera: perception.Intrinsics
     plan: synthesis.GraspPlan | None
+    grasp_height: float | None = None
 
 
 @dataclass(frozen=True)
@@ -105,7 +108,7 @@ class _Planner:
 
     def __call__(self, rgb, depth, intrinsics):
         planned = self.plan(rgb, depth, intrinsics)
-        return planned.T_camera_hand, planned.approach_depth
+        return planned.T_camera_hand, planned.approach_depth, planned.grasp_height
 
 
 @dataclass(frozen=True)
@@ -117,7 +120,7 @@ class SynthesisPlanner(_Planner):
     def plan(self, rgb, depth, intrinsics) -> PlannedGrasp:
         result = pipeline.plan_frame(rgb, depth, intrinsics, self.hand, **dict(self.options))
         return PlannedGrasp(result.plan.pose, result.T_camera_hand, result.metric.approach_depth,
-                            result.segmentation, result.metric, result.camera, result.plan)
+                            result.segmentation, result.metric, result.camera, result.plan, result.grasp_height)
 
 
 @dataclass(frozen=True)

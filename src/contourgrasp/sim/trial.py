@@ -138,6 +138,8 @@ class TrialRecord:
     pose : (3,) float or None
         Planned hand pose (x, y, yaw), image plane; None without a plan.
     approach_depth : float or None
+    grasp_height : float or None
+        The planned height of the open fingertips above the table (None: the execution's rule, or no plan).
     plan_error : str or None
         Why the planner gave no plan (its exception's message); None with a plan.
     sim_time : float
@@ -159,6 +161,7 @@ class TrialRecord:
     hold_drift: float
     pose: tuple[float, float, float] | None
     approach_depth: float | None
+    grasp_height: float | None
     plan_error: str | None
     sim_time: float
     plan_time: float = field(compare=False)
@@ -177,11 +180,12 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
     seed : int
         Chooses the placement and the sensor noise; same seed, same record.
     planner : callable
-        ``planner(rgb, depth, intrinsics) -> (T_camera_hand, approach_depth)``:
+        ``planner(rgb, depth, intrinsics) -> (T_camera_hand, approach_depth[, grasp_height])``:
         ``rgb`` (H, W, 3) uint8, ``depth`` (H, W) float32 m (0 = missing),
         ``intrinsics`` :class:`~contourgrasp.perception.Intrinsics`; returns the
         (4, 4) hand pose in the camera frame (see :func:`hand_pose_from_matrix`)
-        and the approach depth (m). It may raise ``NoFeasibleGrasp`` or
+        and the approach depth (m), and optionally the planned grasp height (m, see
+        :func:`execute_grasp`; None or left out: the execution's own rule). It may raise ``NoFeasibleGrasp`` or
         ``InputError`` when it has no plan.
     hand : Hand or str
         The hand preset the simulated hand is built from.
@@ -201,17 +205,19 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
     rgb, depth = render(scene, noise=noise, seed=seed)
     planning = time.perf_counter()
     try:
-        transform, approach_depth = planner(rgb, depth, camera.intrinsics)
+        transform, approach_depth, *planned_height = planner(rgb, depth, camera.intrinsics)
         plan_error = None
     except (NoFeasibleGrasp, InputError) as err:
         plan_error = str(err)
     plan_time = time.perf_counter() - planning
     if plan_error is None:
-        outcome = asdict(execute_grasp(scene, transform, approach_depth, execution))
-        fields = {k: v for k, v in outcome.items() if k != "palm_depth"} | {"approach_depth": float(approach_depth)}
+        grasp_height = planned_height[0] if planned_height else None
+        outcome = asdict(execute_grasp(scene, transform, approach_depth, execution, grasp_height=grasp_height))
+        fields = {k: v for k, v in outcome.items() if k != "palm_depth"} | {
+            "approach_depth": float(approach_depth), "grasp_height": None if grasp_height is None else float(grasp_height)}
     else:
         fields = {"success": False, "cause": NO_PLAN, "fingers_in_contact": (), "first_contact": (), "push": 0.0,
-                  "lift": 0.0, "hold_drift": 0.0, "pose": None, "approach_depth": None}
+                  "lift": 0.0, "hold_drift": 0.0, "pose": None, "approach_depth": None, "grasp_height": None}
     if observe is not None:
         observe(scene)
     return TrialRecord(object=scene.object.name, seed=seed, **fields, plan_error=plan_error, sim_time=scene.time,
@@ -246,14 +252,22 @@ def pose_matrix(x: float, y: float, yaw: float, depth: float = 0.0) -> np.ndarra
     return np.array([[c, -s, 0.0, x], [s, c, 0.0, y], [0.0, 0.0, 1.0, depth], [0.0, 0.0, 0.0, 1.0]])
 
 
-def execute_grasp(scene: Scene, transform, approach_depth: float,
-                  execution: Execution = Execution()) -> GraspOutcome:
-    """Execute a grasp on a settled scene (module docstring: phases, success, causes)."""
+def execute_grasp(scene: Scene, transform, approach_depth: float, execution: Execution = Execution(), *,
+                  grasp_height: float | None = None) -> GraspOutcome:
+    """Execute a grasp on a settled scene (module docstring: phases, success, causes).
+
+    ``grasp_height`` (m), when the planner chose one: the height above the table of the open hand's
+    lowest fingertip (its tip centre) at the end of the descent, executed as planned instead of
+    the palm-clearance rule of step 2.
+    """
     x, y, yaw = hand_pose_from_matrix(transform)
     world_xy = scene.camera.to_world([x, y, 0.0])[:2]
     top = scene.camera.height - float(approach_depth)  # the planner's idea of the object's top, world z
-    lowest = max(f.radius for f in scene.hand.fingers) + execution.tip_clearance
-    palm_final = max(scene.hand.tip_depth + lowest, top + execution.palm_clearance)
+    if grasp_height is None:
+        lowest = max(f.radius for f in scene.hand.fingers) + execution.tip_clearance
+        palm_final = max(scene.hand.tip_depth + lowest, top + execution.palm_clearance)
+    else:
+        palm_final = scene.hand.open_tip_depth + float(grasp_height)
     palm_start = max(palm_final, top + execution.approach_height + scene.hand.tip_depth)
     probe = _Probe(scene)
     pose = (x, y, yaw)

@@ -12,6 +12,8 @@
 * :mod:`~contourgrasp.synthesis.grid` — the pose grid (eq 3.33, 3.39-3.40, :class:`SearchGrid`), its
   compiled screen (:func:`screen_grid`) and distinct best poses;
 * :mod:`~contourgrasp.synthesis.refine` — continuous refinement off the grid (:func:`refine_poses`);
+* :mod:`~contourgrasp.synthesis.descent` — the open 3-D hand's descent onto the scene's height map
+  (:class:`Descent`, :func:`descent_feasible`, :func:`descent_floor`), a constraint of the search;
 * :mod:`~contourgrasp.synthesis.outer` — the search itself (eq 3.32, :func:`search`);
 * :mod:`~contourgrasp.synthesis.plan` — what it returns (:class:`GraspPlan`, :class:`Cost`, ...).
 
@@ -19,6 +21,7 @@
 """
 
 from .cost import distance, ratio_cost
+from .descent import Descent, DescentCheck, descent_clearance, descent_feasible, descent_floor
 from .evaluate import evaluate_poses
 from .grid import SearchGrid, distinct_best, screen_grid
 from .inner import closest_approach, first_touch
@@ -28,7 +31,7 @@ from .refine import refine_poses
 from .safeguards import Safeguards, fingers_clear, grasp_epsilon
 
 __all__ = [
-    "Alternative", "Cost", "FingerContact", "GraspPlan", "PoseEvaluation", "Refinement", "Safeguards",
-    "SearchGrid", "closest_approach", "distance", "distinct_best", "evaluate_poses", "fingers_clear",
+    "Alternative", "Cost", "Descent", "DescentCheck", "FingerContact", "GraspPlan", "PoseEvaluation", "Refinement", "Safeguards",
+    "SearchGrid", "closest_approach", "descent_clearance", "descent_feasible", "descent_floor", "distance", "distinct_best", "evaluate_poses", "fingers_clear",
     "first_touch", "grasp_epsilon", "ratio_cost", "refine_poses", "screen_grid", "search",
 ]

@@ -1,8 +1,9 @@
 """Descent check: does the open hand, lowered onto the scene, pass above the height map? (issue 16, item 1.3)
 
-Not yet used by any planner: :func:`descent_clearance` and :func:`descent_feasible` are the exact
-check of candidate poses; the per-yaw screening bound over the whole grid and the wiring into
-:func:`~contourgrasp.synthesis.search` are the next steps.
+:func:`descent_clearance` and :func:`descent_feasible` are the exact check of candidate poses;
+:func:`~contourgrasp.synthesis.search` applies it, given a :class:`Descent`, to its candidates in
+increasing cost (:func:`check_candidates`) until it finds feasible ones, and :func:`descent_floor`
+tells how low each pose's open hand can go.
 
 The model
 ---------
@@ -80,6 +81,7 @@ from .. import validation
 from ..errors import HandError, PerceptionError, PlannerError
 from ..hand import Hand, chain_capsules, chain_tip
 from ..perception.height_map import HeightMap
+from ..tolerances import DESCENT_BATCH, DESCENT_MARGIN, MAX_DESCENT_POSES, MAX_HAND_SIZE
 
 #: Parts of a finger's chain, in the order of :func:`~contourgrasp.hand.chain_capsules`.
 FINGER_PARTS = ("post", "proximal", "distal")
@@ -107,6 +109,8 @@ class DescentCheck:
         :func:`body_names`.
     margin : float
         The clearance asked for, m.
+    tip_height : (p,) float
+        The grasp height each pose was checked at, m.
     """
 
     feasible: np.ndarray
@@ -114,6 +118,7 @@ class DescentCheck:
     blocking: np.ndarray
     bodies: tuple[str, ...]
     margin: float
+    tip_height: np.ndarray
 
     def reason(self, i: int) -> str:
         """Why pose ``i`` is refused (or that it is not), e.g. "the index distal strikes the map 3.0 mm deep"."""
@@ -127,6 +132,43 @@ class DescentCheck:
             return f"the {self.bodies[b]} strikes the height map {1000 * -c:.1f} mm deep while descending"
         return (f"the {self.bodies[b]} clears the height map by only {1000 * c:.1f} mm "
                 f"(margin {1000 * self.margin:g} mm)")
+
+
+@dataclass(frozen=True, eq=False)
+class Descent:
+    """What :func:`~contourgrasp.synthesis.search` checks the open hand's descent against.
+
+    A candidate pose's hand descends until its lowest fingertip is ``tip_height`` above the table;
+    where a body would pass less than ``margin`` above the map on the way, the hand stops higher,
+    as high as that body needs (:func:`descent_floor`), but no higher than ``max_tip_height``:
+    above it the pose is infeasible.
+
+    Attributes
+    ----------
+    heights : HeightMap
+        The scene, in the planning frame of the contour searched.
+    tip_height : float
+        The grasp height asked for: the open hand's lowest fingertip (tip centre) above the table
+        at the end of the descent, m.
+    max_tip_height : float
+        The highest grasp height accepted, m (at least ``tip_height``; equal: no raising).
+    margin : float
+        Clearance every body keeps over the map, m (``tolerances.DESCENT_MARGIN``).
+    """
+
+    heights: HeightMap
+    tip_height: float
+    max_tip_height: float
+    margin: float = DESCENT_MARGIN
+
+    def __post_init__(self):
+        if not isinstance(self.heights, HeightMap):
+            raise PerceptionError(f"Descent.heights must be a HeightMap, got {type(self.heights).__name__}")
+        validation.finite("tip_height", self.tip_height, error=PlannerError)
+        validation.finite("max_tip_height", self.max_tip_height, error=PlannerError)
+        if self.max_tip_height < self.tip_height:
+            raise PlannerError(f"max_tip_height ({self.max_tip_height:g} m) is below tip_height ({self.tip_height:g} m)")
+        validation.bounded("margin", self.margin, MAX_HAND_SIZE, " m", error=PlannerError)
 
 
 def body_names(hand: Hand) -> tuple[str, ...]:
@@ -193,14 +235,64 @@ def descent_feasible(hand: Hand, heights: HeightMap, poses, tip_height, *, margi
     HandError, PerceptionError, PlannerError
         As :func:`descent_clearance`; PlannerError for a bad ``margin``.
     """
-    from ..tolerances import MAX_HAND_SIZE
-
     margin = validation.bounded("margin", margin, MAX_HAND_SIZE, " m", error=PlannerError)
     clearance = descent_clearance(hand, heights, poses, tip_height)
     worst = clearance.argmin(axis=1) if clearance.size else np.zeros(0, dtype=int)
     feasible = clearance.min(axis=1) >= margin if len(clearance) else np.zeros(0, dtype=bool)
+    tip = np.broadcast_to(np.asarray(tip_height, dtype=float), (len(clearance),)).copy()
     return DescentCheck(feasible=feasible, clearance=clearance, blocking=np.where(feasible, -1, worst),
-                        bodies=body_names(hand), margin=margin)
+                        bodies=body_names(hand), margin=margin, tip_height=tip)
+
+
+def descent_floor(hand: Hand, heights: HeightMap, poses) -> np.ndarray:
+    """(p,) float: the lowest height above the table each pose's open hand can bring its lowest tip to.
+
+    The hand moves by a translation along the approach axis, so every clearance of
+    :func:`descent_clearance` grows one for one with ``tip_height``: the floor is the tip height at
+    which the least clearance is zero (+inf where a body passes out of view, -inf over no cell).
+    """
+    clearance = descent_clearance(hand, heights, poses, 0.0)
+    return -clearance.min(axis=1) if clearance.size else np.zeros(len(clearance))
+
+
+def check_candidates(hand: Hand, descent: Descent, poses, order) -> tuple[np.ndarray, np.ndarray, DescentCheck | None]:
+    """The descent check of candidate poses in the given order, a batch at a time, until a batch has a feasible one.
+
+    Parameters
+    ----------
+    hand : Hand
+    descent : Descent
+    poses : (p, 3) float
+    order : (m,) int
+        Indices into ``poses`` to check, best first.
+
+    Returns
+    -------
+    passed : (p,) bool
+        True for the checked poses whose hand descends clear to a grasp height at most
+        ``descent.max_tip_height``; every pose not checked is False.
+    tip_height : (p,) float
+        The grasp height of each checked pose: ``descent.tip_height``, or higher where a body needs it
+        (NaN where not checked).
+    last : DescentCheck or None
+        The check of the last batch at ``descent.tip_height`` (for the reason none passed); None when
+        ``order`` is empty.
+
+    At most ``tolerances.MAX_DESCENT_POSES`` poses are checked.
+    """
+    passed = np.zeros(len(poses), dtype=bool)
+    tip = np.full(len(poses), np.nan)
+    last = None
+    order = np.asarray(order, dtype=np.intp)[:MAX_DESCENT_POSES]
+    for a in range(0, len(order), DESCENT_BATCH):
+        rows = order[a:a + DESCENT_BATCH]
+        last = descent_feasible(hand, descent.heights, poses[rows], descent.tip_height, margin=descent.margin)
+        raised = descent.tip_height + np.maximum(descent.margin - last.clearance.min(axis=1), 0.0)
+        tip[rows] = raised
+        passed[rows] = raised <= descent.max_tip_height
+        if passed[rows].any():
+            break
+    return passed, tip, last
 
 
 def _check_hand(hand) -> None:

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import replace
 from typing import Literal
 
 import numpy as np
@@ -33,6 +34,7 @@ from ..errors import HandError, NoFeasibleGrasp, PlannerError
 from ..hand import Hand, to_image
 from ._derived import hand_arrays
 from .cost import distance
+from .descent import Descent, DescentCheck, body_names, check_candidates, descent_feasible
 from .evaluate import concatenate, evaluate_poses
 from .grid import SearchGrid, distinct_best, screen_grid
 from .inner import closest_approach
@@ -58,6 +60,7 @@ def search(
     friction: float = 0.5,
     require_closure: bool = False,
     quality_gain: float = 0.0,
+    descent: Descent | None = None,
 ) -> GraspPlan:
     """Plan a grasp on a contour: fit the EFD model, search the pose grid, return the best pose.
 
@@ -90,6 +93,13 @@ def search(
     finger_thickness, clearance, friction, require_closure, quality_gain
         The :class:`~contourgrasp.synthesis.Safeguards` (all off: the thesis's problem).
         ``friction`` is also the mu of the plan's reported ``quality``.
+    descent : Descent, optional
+        The scene's height map and the grasp height: a pose is feasible only if the open hand,
+        lowered along the approach axis until its lowest fingertip is at ``descent.tip_height``,
+        keeps every finger's body and the palm ``descent.margin`` above the map
+        (:mod:`~contourgrasp.synthesis.descent`; the hand must be 3-D). Checked exactly on the
+        candidates in increasing cost, after their inner problem, until one passes. Without it:
+        the thesis's 2-D problem.
 
     Returns
     -------
@@ -116,6 +126,10 @@ def search(
     refine = check.flag("refine", refine, error=PlannerError)
     if not isinstance(hand, Hand):
         raise HandError(f"hand must be a Hand, got {type(hand).__name__} (contourgrasp.synthesize loads names)")
+    if descent is not None:
+        if not isinstance(descent, Descent):
+            raise PlannerError(f"descent must be a contourgrasp.synthesis.Descent, got {type(descent).__name__}")
+        body_names(hand)  # refuses a hand without 3-D geometry
     grid = SearchGrid(xy_step=xy_step, yaw_step=yaw_step, d_max=d_max, d_min=d_min)
     safeguards = Safeguards(finger_thickness=check.flag("finger_thickness", finger_thickness, error=PlannerError),
                             clearance=clearance, friction=friction,
@@ -133,7 +147,7 @@ def search(
     if not screen.feasible.any():
         raise NoFeasibleGrasp(_diagnose(screen, hand, grid))
     result = _reevaluate_best(model, hand, screen, max(tol.REFINE_CANDIDATES, 4 * top_k), curvature, grid.d_min,
-                              safeguards)
+                              safeguards, descent)
     ranked = distinct_best(result, grid, top_k)
     exact = time.perf_counter()
     refinement, refined_at = None, exact
@@ -142,12 +156,16 @@ def search(
         refined = refine_poses(model, hand, result.poses[ranked[:tol.REFINE_STARTS]],
                                step=(grid.xy_step, grid.yaw_step), d_max=grid.d_max,
                                curvature=curvature, d_min=grid.d_min, safeguards=safeguards)
+        if descent is not None:
+            passed, _, _ = check_candidates(hand, descent, refined.poses, _by_cost(refined))
+            refined = replace(refined, feasible=refined.feasible & passed)
         result = concatenate(refined, result)
         ranked = distinct_best(result, grid, top_k)
         refinement = Refinement(tuple(map(float, result.poses[len(refined.poses) + grid_best])),
                                 float(result.cost[len(refined.poses) + grid_best]), float(result.cost[ranked[0]]))
         refined_at = time.perf_counter()
     best = ranked[0]
+    descended = None if descent is None else _descended(hand, descent, result.poses[best:best + 1])
     fingers = _contacts(model, hand, result, best, curvature)
     grasp_quality = _quality(model, result, best, friction)
     timing = {
@@ -173,6 +191,7 @@ def search(
         refinement=refinement,
         safeguards=safeguards,
         quality=grasp_quality,
+        descent=descended,
     )
 
 
@@ -186,18 +205,53 @@ def _check_harmonics(harmonics) -> None:
 
 
 def _reevaluate_best(model, hand, screen: PoseEvaluation, n: int, curvature, d_min,
-                     safeguards: Safeguards) -> PoseEvaluation:
-    """Exact evaluation of the n cheapest screened poses, then 4n, 16n, ... until one is feasible."""
+                     safeguards: Safeguards, descent: Descent | None = None) -> PoseEvaluation:
+    """Exact evaluation of the n cheapest screened poses, then 4n, 16n, ... until one is feasible.
+
+    With ``descent``, feasible also means the open hand descends clear (checked in increasing cost,
+    each pose once, at most ``tolerances.MAX_DESCENT_POSES`` in all).
+    """
     feasible = np.flatnonzero(screen.feasible)
     order = feasible[np.argsort(screen.cost[feasible], kind="stable")]
+    checked, descended, last = 0, 0, None
     while True:
         result = evaluate_poses(model, hand, screen.poses[order[:n]], curvature=curvature, d_min=d_min,
                                 safeguards=safeguards)
+        if descent is not None and result.feasible.any():
+            candidates = _by_cost(result)
+            candidates = candidates[candidates >= checked]  # poses [0, checked) were checked before
+            passed, _, check = check_candidates(hand, descent, result.poses, candidates)
+            passed[:checked] = False
+            last = check or last
+            checked, descended = min(n, len(order)), descended + min(len(candidates), tol.MAX_DESCENT_POSES)
+            result = replace(result, feasible=result.feasible & passed)
         if result.feasible.any():
             return result
-        if n >= len(order):
-            raise NoFeasibleGrasp(_diagnose_exact(result, safeguards))
+        if n >= len(order) or descended >= tol.MAX_DESCENT_POSES:
+            raise NoFeasibleGrasp(_diagnose_descent(last, descended, descent) if last is not None
+                                  else _diagnose_exact(result, safeguards))
         n *= 4
+
+
+def _descended(hand: Hand, descent: Descent, pose) -> DescentCheck:
+    """The descent check of one pose at its grasp height (raised from ``descent.tip_height`` where it must be)."""
+    _, tip, _ = check_candidates(hand, descent, pose, [0])
+    return descent_feasible(hand, descent.heights, pose, tip, margin=descent.margin)
+
+
+def _by_cost(result: PoseEvaluation) -> np.ndarray:
+    """Indices of the feasible poses of an evaluation, in increasing cost."""
+    feasible = np.flatnonzero(result.feasible)
+    return feasible[np.argsort(result.cost[feasible], kind="stable")]
+
+
+def _diagnose_descent(check: DescentCheck, n: int, descent: Descent) -> str:
+    """Why every pose that reaches the object fails the descent check, with the best one's reason."""
+    best = int(np.argmax(check.clearance.min(axis=1)))
+    limit = (f"at a grasp height of {1000 * descent.tip_height:.0f} mm" if descent.max_tip_height == descent.tip_height
+             else f"at any grasp height from {1000 * descent.tip_height:.0f} to {1000 * descent.max_tip_height:.0f} mm")
+    return (f"every one of the {n} poses checked that reach the object would strike the scene while the open "
+            f"hand descends {limit}; at the clearest, {check.reason(best)}")
 
 
 def _diagnose_exact(result: PoseEvaluation, safeguards: Safeguards) -> str:

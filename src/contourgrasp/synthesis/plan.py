@@ -14,6 +14,7 @@ from ..quality import GraspQuality
 if TYPE_CHECKING:
     from .grid import SearchGrid
     from .safeguards import Safeguards
+    from .descent import DescentCheck
 
 
 @dataclass(frozen=True, eq=False)
@@ -167,6 +168,9 @@ class GraspPlan:
     safeguards : Safeguards
     quality : contourgrasp.quality.GraspQuality
         Force closure and Ferrari-Canny L1 epsilon of the grasp points (missed fingers excluded).
+    descent : DescentCheck or None
+        The descent check of ``pose`` (one row: each finger's body's and the palm's clearance over
+        the height map); None when the search had no :class:`~contourgrasp.synthesis.Descent`.
     notes : tuple of str
         What the plan could not take into account (a property: see :func:`plan_notes`).
     """
@@ -186,6 +190,7 @@ class GraspPlan:
     refinement: Refinement | None
     safeguards: Safeguards
     quality: GraspQuality
+    descent: DescentCheck | None = None
 
     @property
     def notes(self) -> tuple[str, ...]:

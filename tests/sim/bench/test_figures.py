@@ -16,7 +16,7 @@ from contourgrasp.sim.trial import TrialRecord
 
 MODULES = ("config", "parallel", "run", "stats", "report", "journal", "figures")
 RECORD = dict(seed=0, fingers_in_contact=(), first_contact=(), push=0.0, lift=0.0, hold_drift=0.0, pose=None,
-              approach_depth=None, plan_error=None, sim_time=1.0, plan_time=0.1, wall_time=1.0)
+              approach_depth=None, grasp_height=None, plan_error=None, sim_time=1.0, plan_time=0.1, wall_time=1.0)
 
 
 def test_figures_are_drawn_from_results():

@@ -16,7 +16,7 @@ from contourgrasp.sim.trial import TrialRecord
 
 RECORD = dict(object="can", seed=3, success=False, cause="dropped", fingers_in_contact=("thumb", "index"),
               first_contact=(("thumb", 0.25), ("index", 0.5)), push=0.001, lift=0.12, hold_drift=0.03,
-              pose=(0.01, -0.02, 1.5), approach_depth=0.4, plan_error=None, sim_time=6.1, plan_time=0.1, wall_time=1.0)
+              pose=(0.01, -0.02, 1.5), approach_depth=0.4, grasp_height=None, plan_error=None, sim_time=6.1, plan_time=0.1, wall_time=1.0)
 
 
 def run_cli(argv, capsys) -> tuple[int, str]:

@@ -68,7 +68,7 @@ def test_ablation_table_counts_rates_and_causes():
     ran = (*steps[:-1], "default")
     bench = Bench(objects=(contourgrasp.sim.objects.object_spec("can"),), planners=ran, trials=2)
     record = dict(object="can", seed=0, fingers_in_contact=(), first_contact=(), push=0.0, lift=0.0, hold_drift=0.0,
-                  pose=None, approach_depth=None, plan_error=None, sim_time=1.0, plan_time=0.1, wall_time=1.0)
+                  pose=None, approach_depth=None, grasp_height=None, plan_error=None, sim_time=1.0, plan_time=0.1, wall_time=1.0)
     results = [BenchTrial(p, t, TrialRecord(success=t == 0, cause=None if t == 0 else PUSHED, **record))
                for p in ran for t in range(2)]
     table = ablation_table(bench, results)
@@ -91,7 +91,7 @@ def test_a_planner_file_runs_on_the_bench(tmp_path, capsys):
 def _split_results(bench, rates):
     """Trials with ``rates[planner][object]`` successes of 2; failures dropped after a plan (pose set)."""
     record = dict(seed=0, fingers_in_contact=(), first_contact=(), push=0.0, lift=0.0, hold_drift=0.0,
-                  pose=None, approach_depth=None, plan_error=None, sim_time=1.0, plan_time=0.1, wall_time=1.0)
+                  pose=None, approach_depth=None, grasp_height=None, plan_error=None, sim_time=1.0, plan_time=0.1, wall_time=1.0)
     return [BenchTrial(p, t, TrialRecord(object=o.name, success=t < rates[p][o.name], cause=None if t < rates[p][o.name]
                                          else PUSHED, **record))
             for p in bench.planners for o in bench.objects for t in range(bench.trials)]

@@ -48,4 +48,4 @@ def test_trials_run_object_by_object_and_come_back_planner_by_planner():
 def _record(obj, success):
     return TrialRecord(object=obj, seed=0, success=success, cause=None if success else "dropped",
                        fingers_in_contact=(), first_contact=(), push=0.0, lift=0.0, hold_drift=0.0, pose=None,
-                       approach_depth=None, plan_error=None, sim_time=1.0, plan_time=0.1, wall_time=1.0)
+                       approach_depth=None, grasp_height=None, plan_error=None, sim_time=1.0, plan_time=0.1, wall_time=1.0)

@@ -57,6 +57,7 @@ def trial_from_dict(data: dict) -> BenchTrial:
     """The trial of a :func:`trial_to_dict` record (read back from JSON): equal to the one written."""
     fields = dict(data)
     planner, trial, pose = fields.pop("planner"), fields.pop("trial"), fields.pop("pose")
+    fields.setdefault("grasp_height", None)  # journals written before planned grasp heights
     fields["fingers_in_contact"] = tuple(fields["fingers_in_contact"])
     fields["first_contact"] = tuple((finger, t) for finger, t in fields["first_contact"])
     fields["pose"] = None if pose is None else (pose["x"], pose["y"], pose["yaw"])

@@ -147,7 +147,7 @@ def snapshot(bench: Bench, result: BenchTrial) -> Snapshot:
 
     def recording(rgb, depth, intrinsics):
         seen["rgb"], seen["planned"] = rgb, planner.plan(rgb, depth, intrinsics)
-        return seen["planned"].T_camera_hand, seen["planned"].approach_depth
+        return seen["planned"].T_camera_hand, seen["planned"].approach_depth, seen["planned"].grasp_height
 
     def observe(scene):
         palm, _ = scene.palm_pose()

@@ -1,0 +1,68 @@
+"""Grasp height: how far above the table the open hand's fingertips stop (issue 16, item 1.4).
+
+The thesis's hand descends to a depth its operator chose (3.1.1, 4.1.4). With a 3-D hand and the
+scene's height map the planner chooses it, as the height above the table of the open hand's lowest
+fingertip (its tip centre) at the end of the descent, the ``tip_height`` of
+:class:`~contourgrasp.synthesis.Descent`. Rules (:data:`GRASP_HEIGHT_RULES`):
+
+Each rule gives the height asked for and the highest accepted (:class:`~contourgrasp.synthesis.Descent`):
+a pose whose open hand cannot descend that low stops as high as its bodies need, up to the highest.
+
+``"clearance"``
+    The rule the simulated execution applied before the planner chose a height: the tips just
+    above the table while they close (the lowest tip of the closing hand, :attr:`Hand.closing_tip_depth`,
+    its radius plus ``tolerances.GRASP_TIP_CLEARANCE`` up), unless that brings the palm's underside
+    closer than ``tolerances.GRASP_PALM_CLEARANCE`` to the object's top; then that high. Never raised.
+``"auto"``
+    The same height asked for, raised where the bodies need it up to
+    ``tolerances.GRASP_HEIGHT_FRACTION`` of the object's height: the tips still close on its lower
+    part, below its widest part for most objects lying or standing on a table. Chosen on the
+    ``ycb-train`` objects (README, "3-D hand").
+"""
+
+from __future__ import annotations
+
+import math
+
+from .. import tolerances as tol
+from .. import validation
+from ..errors import PlannerError
+from ..hand import Hand
+from ..perception.height_map import HeightMap
+
+#: The rules of :func:`grasp_height`.
+GRASP_HEIGHT_RULES = ("clearance", "auto")
+
+
+def grasp_height(hand: Hand, heights: HeightMap, rule: str | float = "auto") -> tuple[float, float]:
+    """The grasp height asked for and the highest accepted: the open hand's lowest fingertip above the table, m.
+
+    Parameters
+    ----------
+    hand : Hand
+        A 3-D hand (its chains give the tips' radius and depth below the palm).
+    heights : HeightMap
+        The scene; its ``max_height`` is the object's top.
+    rule : {"clearance", "auto"} or float
+        A rule of the module's docstring, or the height itself (m, at most ``MAX_HAND_SIZE``, never raised).
+
+    Returns
+    -------
+    (float, float)
+
+    Raises
+    ------
+    PlannerError
+        Unknown rule, or a height that is not a finite number in [0, ``MAX_HAND_SIZE``].
+    """
+    if not isinstance(rule, str):
+        height = validation.bounded("grasp_height", rule, tol.MAX_HAND_SIZE, " m", error=PlannerError)
+        return height, height
+    validation.choice("grasp_height", rule, GRASP_HEIGHT_RULES, error=PlannerError)
+    top = float(heights.max_height) if math.isfinite(heights.max_height) else 0.0
+    swing = hand.closing_tip_depth - hand.open_tip_depth
+    floor = max(c.radius for c in hand.chains) + tol.GRASP_TIP_CLEARANCE + swing
+    height = max(floor, top + tol.GRASP_PALM_CLEARANCE - hand.open_tip_depth)
+    if rule == "clearance":
+        return height, height
+    return height, max(height, tol.GRASP_HEIGHT_FRACTION * top)
