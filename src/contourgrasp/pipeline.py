@@ -113,6 +113,7 @@ def plan_frame(
     roi=None,
     descent: bool = False,
     grasp_height: str | float | None = None,
+    slice_contour: bool = False,
     **synthesis_options,
 ) -> ImageGraspPlan:
     """Plan a grasp on one RGB-D frame with a :class:`~contourgrasp.hand.Hand`.
@@ -173,6 +174,10 @@ def plan_frame(
         ``"clearance"``. Planned, it is the plan's ``grasp_height`` and ``T_camera_hand`` is the
         hand at that height; None without ``descent``: ``T_camera_hand`` is at the approach
         depth and the executor chooses how deep to go, as in the thesis.
+    slice_contour : bool
+        With a planned grasp height: plan on the object's cross-section at that height
+        (:func:`contourgrasp.perception.cross_section`) rather than its outline as seen, where the
+        height map has one.
     **synthesis_options
         Keyword options of :func:`contourgrasp.synthesis.search`.
 
@@ -203,7 +208,11 @@ def plan_frame(
     heights = scene_heights(d, intrinsics, seg, metric, plane=table)
     asked = _grasp_height(hand, heights, descent, grasp_height)
     spec = Descent(heights, *asked) if descent and asked is not None else None
-    plan = search(metric.contour_xy, hand, descent=spec, **synthesis_options)
+    contour = metric.contour_xy
+    if validation.flag("slice_contour", slice_contour, error=PlannerError) and asked is not None:
+        section = perception.cross_section(heights, asked[0])
+        contour = contour if section is None else section
+    plan = search(contour, hand, descent=spec, **synthesis_options)
     tip_height = None if asked is None else asked[0] if plan.descent is None else float(plan.descent.tip_height[0])
     depth_at = (metric.approach_depth if tip_height is None
                 else _palm_depth(metric, heights, hand, plan.pose, tip_height))

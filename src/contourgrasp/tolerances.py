@@ -332,6 +332,11 @@ MAX_DESCENT_POSES = 4096
 GRASP_TIP_CLEARANCE = 0.003
 GRASP_PALM_CLEARANCE = 0.02
 
-#: Grasp height rule "auto": the highest grasp height accepted, as a fraction of the object's height.
-#: Chosen on ycb-train (README, "3-D hand").
+#: Grasp height rule "auto": the grasp height asked for, and the highest accepted where the hand's bodies need
+#: it higher, as fractions of the object's height. Chosen on ycb-train (README, "3-D hand").
 GRASP_HEIGHT_FRACTION = 0.5
+MAX_GRASP_HEIGHT_FRACTION = 0.7
+
+#: perception.cross_section: fewer object cells than this standing at the grasp height (m^2 / cell^2: 50 cells of
+#: 2 mm are 2 cm^2) is no section: the fingertips would close under the object's top on almost nothing.
+MIN_SECTION_CELLS = 50

@@ -26,6 +26,7 @@ which is the thesis's setting)::
     quality_gain = 0.0
     descent = false              # the open 3-D hand's descent onto the height map (synthesis.Descent)
     grasp_height = "clearance"   # or "auto", or a height in m (synthesis.grasp_height)
+    slice_contour = false        # plan on the cross-section at the grasp height (perception.cross_section)
 
 Unknown keys, wrong types and impossible values are refused with
 :class:`PlannerFileError` naming the file and the field; so is a file that is not UTF-8 text or
@@ -49,7 +50,7 @@ _PRESET_DIR = "data/planners"
 #: Options that belong to perception, and to planning in the scene's 3-D (the rest are
 #: :func:`contourgrasp.synthesis.search`'s).
 PERCEPTION_OPTIONS = ("depth_mode", "footprint")
-SCENE_OPTIONS = ("descent", "grasp_height")
+SCENE_OPTIONS = ("descent", "grasp_height", "slice_contour")
 
 Positive = Annotated[float, Field(gt=0, le=tol.MAX_SEARCH_LENGTH, allow_inf_nan=False)]
 Distance = Annotated[float, Field(ge=0, le=tol.MAX_SEARCH_LENGTH, allow_inf_nan=False)]
@@ -76,6 +77,7 @@ class _PlannerSchema(BaseModel):
     require_closure: bool | None = None
     quality_gain: NonNegative | None = None
     descent: bool | None = None
+    slice_contour: bool | None = None
     grasp_height: (Literal["clearance", "auto"]
                    | Annotated[float, Field(ge=0, le=tol.MAX_HAND_SIZE, allow_inf_nan=False)] | None) = None
 

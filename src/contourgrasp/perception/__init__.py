@@ -19,6 +19,8 @@ One module per stage, in the order the pipeline runs them:
   the approach depth (3.1.1)
 * :mod:`~contourgrasp.perception.height_map` -- heights above the table on a grid in the planning
   frame, the object's cells marked (:class:`HeightMap`)
+* :mod:`~contourgrasp.perception.cross_section` -- the object's outline at a height, from the height
+  map (:func:`cross_section`)
 
 Conventions: see :mod:`~contourgrasp.perception.camera`. The thresholds are in
 :mod:`contourgrasp.tolerances`; measured results (IoU against the hand-made
@@ -31,6 +33,7 @@ from ..errors import PerceptionError, PerceptionWarning, SegmentationError
 from .camera import Intrinsics, as_depth, backproject, denoised_depth, fill_depth_holes, valid_depth
 from .candidates import TARGET_RULES, Candidate, choose_target, find_candidates
 from .colour import add_flat_parts, colour_offset, register_colour
+from .cross_section import cross_section
 from .height_map import HeightMap, height_map
 from .metric import DEPTH_MODES, DepthMode, MetricContour, approach_depth, contour_to_metric
 from .region import Segmentation, mask_contour
@@ -43,6 +46,6 @@ __all__ = [
     "Candidate", "DEPTH_MODES", "DepthMode", "HeightMap", "Intrinsics", "MetricContour", "PerceptionError", "PerceptionWarning", "Plane",
     "SEGMENT_METHODS", "SegmentMethod", "Segmentation", "SegmentationError", "TARGET_RULES", "add_flat_parts", "approach_depth",
     "as_depth", "backproject", "choose_target", "colour_offset", "contour_to_metric", "denoised_depth", "fill_depth_holes",
-    "find_candidates", "fit_plane", "fit_table_plane", "height_map", "mask_contour", "object_footprint", "register_colour", "segment",
+    "cross_section", "find_candidates", "fit_plane", "fit_table_plane", "height_map", "mask_contour", "object_footprint", "register_colour", "segment",
     "segment_depth", "segment_from_mask", "segment_rgb", "valid_depth",
 ]

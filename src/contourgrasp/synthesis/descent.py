@@ -82,12 +82,10 @@ from ..errors import HandError, PerceptionError, PlannerError
 from ..hand import Hand, chain_capsules, chain_tip
 from ..perception.height_map import HeightMap
 from ..tolerances import DESCENT_BATCH, DESCENT_MARGIN, MAX_DESCENT_POSES, MAX_HAND_SIZE
+from ._descent_kernels import clearances
 
 #: Parts of a finger's chain, in the order of :func:`~contourgrasp.hand.chain_capsules`.
 FINGER_PARTS = ("post", "proximal", "distal")
-
-#: Poses evaluated at once (bounds the arrays: a batch x a window's cells).
-_POSE_BATCH = 128
 
 #: An axis with ``1 - u_z^2`` below this is vertical: its capsule's lowest points are its end balls'.
 _VERTICAL = 1e-12
@@ -209,13 +207,19 @@ def descent_clearance(hand: Hand, heights: HeightMap, poses, tip_height) -> np.n
     """
     _check_hand(hand)
     poses, tip, normal = _check_inputs(heights, poses, tip_height)
-    layer = heights.conservative()
-    out = np.empty((len(poses), 3 * len(hand.chains) + 1))
-    capsules = [(c.radius, chain_capsules(c, 0.0)[0]) for c in hand.chains]
+    ends = np.ascontiguousarray(np.concatenate([chain_capsules(c, 0.0)[0] for c in hand.chains]))  # (3n, 2, 3)
+    radii = np.repeat([c.radius for c in hand.chains], 3).astype(float)
     tips = np.array([chain_tip(c, 0.0)[0] for c in hand.chains])  # (n, 3)
-    for a in range(0, len(poses), _POSE_BATCH):
-        sl = slice(a, a + _POSE_BATCH)
-        out[sl] = _batch(hand, heights, layer, normal, capsules, tips, poses[sl], tip[sl])
+    # Height of a hand point at planning (x, y) and hand depth z: n_xy . (x, y) + n_z z + base, with base
+    # fixed by the lowest tip being at tip_height (the palm's planning depth cancels out).
+    c, s = np.cos(poses[:, 2])[:, None], np.sin(poses[:, 2])[:, None]
+    tip_x = poses[:, :1] + c * tips[None, :, 0] - s * tips[None, :, 1]
+    tip_y = poses[:, 1:2] + s * tips[None, :, 0] + c * tips[None, :, 1]
+    base = tip - (normal[0] * tip_x + normal[1] * tip_y + normal[2] * tips[None, :, 2]).min(axis=1)
+    out = np.empty((len(poses), len(ends) + 1))
+    clearances(np.ascontiguousarray(heights.conservative(), dtype=float), np.asarray(heights.origin, dtype=float),
+               float(heights.cell), normal, poses, base, ends, radii,
+               np.ascontiguousarray(hand.palm.points, dtype=float), _VERTICAL, out)
     return out
 
 
@@ -320,104 +324,3 @@ def _check_inputs(heights, poses, tip_height):
     return poses, tip, normal
 
 
-def _window(centre_xy, half, heights):
-    """Cells of a square window of half-side ``half`` (m) around points (B, 2): rows, cols (B, m) and their centres (B, m, 2)."""
-    k = int(math.ceil(half / heights.cell)) + 1
-    off = np.arange(-k, k + 1)
-    dj, di = (g.ravel() for g in np.meshgrid(off, off))
-    base = np.floor((centre_xy - heights.origin) / heights.cell).astype(np.intp)  # (B, 2): col, row
-    cols = base[:, :1] + dj[None]
-    rows = base[:, 1:] + di[None]
-    centres = np.stack([heights.origin[0] + (cols + 0.5) * heights.cell,
-                        heights.origin[1] + (rows + 0.5) * heights.cell], axis=-1)
-    return rows, cols, centres
-
-
-def _cell_heights(layer, rows, cols):
-    """The layer at cells (any shape); +inf off the grid."""
-    ny, nx = layer.shape
-    inside = (rows >= 0) & (rows < ny) & (cols >= 0) & (cols < nx)
-    return np.where(inside, layer[np.clip(rows, 0, ny - 1), np.clip(cols, 0, nx - 1)], np.inf)
-
-
-def _to_hand(centres, poses):
-    """Planning-frame points (B, m, 2) in the hand frame of each pose: R(yaw)^T (p - (x, y))."""
-    c, s = np.cos(poses[:, 2])[:, None], np.sin(poses[:, 2])[:, None]
-    dx, dy = centres[..., 0] - poses[:, :1], centres[..., 1] - poses[:, 1:2]
-    return c * dx + s * dy, -s * dx + c * dy
-
-
-def _lowest_z(qx, qy, A, B, r):
-    """(B, m) float: the capsule's lowest point (largest z) on the vertical lines at hand-frame (qx, qy); -inf off it."""
-    low = np.full(qx.shape, -np.inf)
-    for end in (A, B):
-        d2 = (qx - end[0]) ** 2 + (qy - end[1]) ** 2
-        with np.errstate(invalid="ignore"):
-            low = np.maximum(low, np.where(d2 <= r * r, end[2] + np.sqrt(np.maximum(r * r - d2, 0.0)), -np.inf))
-    axis = B - A
-    length = float(np.linalg.norm(axis))
-    if length > 0:
-        u = axis / length
-        k = 1.0 - u[2] ** 2
-        if k > _VERTICAL:
-            wx, wy = qx - A[0], qy - A[1]
-            a = wx * u[0] + wy * u[1]
-            w2 = wx * wx + wy * wy
-            disc = (a * u[2]) ** 2 - k * (w2 - a * a - r * r)
-            with np.errstate(invalid="ignore"):
-                z = (a * u[2] + np.sqrt(disc)) / k
-            t = a + z * u[2]
-            ok = (disc >= 0) & (t >= 0) & (t <= length)
-            low = np.maximum(low, np.where(ok, A[2] + z, -np.inf))
-    return low
-
-
-def _inside_polygon(qx, qy, polygon):
-    """(B, m) bool: even-odd test of hand-frame points against the polygon (k, 2)."""
-    inside = np.zeros(qx.shape, dtype=bool)
-    x0, y0 = polygon[:, 0], polygon[:, 1]
-    x1, y1 = np.roll(x0, -1), np.roll(y0, -1)
-    for a, b, c, d in zip(x0, y0, x1, y1):
-        if b == d:
-            continue
-        crosses = (b > qy) != (d > qy)
-        x_at = a + (qy - b) * (c - a) / (d - b)
-        inside ^= crosses & (qx < x_at)
-    return inside
-
-
-def _batch(hand, heights, layer, normal, capsules, tips, poses, tip):
-    """descent_clearance for one batch of poses."""
-    c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
-
-    def planning_xy(hxy):  # hand-frame (2,) -> planning (B, 2)
-        return np.stack([poses[:, 0] + c * hxy[0] - s * hxy[1], poses[:, 1] + s * hxy[0] + c * hxy[1]], axis=-1)
-
-    # Height of a hand point at planning (x, y) and hand depth z: n_xy . (x, y) + n_z z + base, with base
-    # fixed by the lowest tip being at tip_height (the palm's planning depth cancels out).
-    tip_xy = np.stack([planning_xy(t[:2]) for t in tips], axis=1)  # (B, n, 2)
-    g = tip_xy @ normal[:2] + normal[2] * tips[:, 2][None]
-    base = tip - g.min(axis=1)  # (B,)
-
-    def clearance(low_z, centres, rows, cols):
-        h = centres @ normal[:2] + normal[2] * low_z + base[:, None]
-        cell = _cell_heights(layer, rows, cols)
-        with np.errstate(invalid="ignore"):
-            gap = np.where(np.isfinite(low_z), h - cell, np.inf)
-        return gap.min(axis=1)
-
-    columns = []
-    for r, caps in capsules:
-        for A, B in caps:
-            lo = np.minimum(A[:2], B[:2]) - r
-            hi = np.maximum(A[:2], B[:2]) + r
-            centre, half = (lo + hi) / 2, float(np.linalg.norm(hi - lo)) / 2
-            rows, cols, centres = _window(planning_xy(centre), half, heights)
-            qx, qy = _to_hand(centres, poses)
-            columns.append(clearance(_lowest_z(qx, qy, A, B, r), centres, rows, cols))
-    outline = hand.palm.points
-    lo, hi = outline.min(axis=0), outline.max(axis=0)
-    rows, cols, centres = _window(planning_xy((lo + hi) / 2), float(np.linalg.norm(hi - lo)) / 2, heights)
-    qx, qy = _to_hand(centres, poses)
-    columns.append(clearance(np.where(_inside_polygon(qx, qy, outline), 0.0, -np.inf), centres, rows, cols))
-    return np.stack(columns, axis=1)

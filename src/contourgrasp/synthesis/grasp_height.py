@@ -65,4 +65,5 @@ def grasp_height(hand: Hand, heights: HeightMap, rule: str | float = "auto") -> 
     height = max(floor, top + tol.GRASP_PALM_CLEARANCE - hand.open_tip_depth)
     if rule == "clearance":
         return height, height
-    return height, max(height, tol.GRASP_HEIGHT_FRACTION * top)
+    asked = max(height, tol.GRASP_HEIGHT_FRACTION * top)
+    return asked, max(asked, tol.MAX_GRASP_HEIGHT_FRACTION * top)

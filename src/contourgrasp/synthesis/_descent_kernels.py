@@ -1,0 +1,121 @@
+"""Compiled descent clearances (numba): the one user is :func:`contourgrasp.synthesis.descent.descent_clearance`.
+
+Per pose and body the kernel walks the cells of the body's footprint's bounding box and keeps the
+least gap between the body's lowest point over a cell's centre line and the cell's height (the
+module docstring of :mod:`~contourgrasp.synthesis.descent` has the geometry). A cell is skipped when
+even the body's lowest point anywhere (an end ball's bottom: heights are linear along a capsule's
+axis) could not lower the least gap found so far, so cells far below the hand cost a comparison.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def capsule_lowest(qx, qy, a, b, r, vertical):
+    """Largest z (lowest point, z down) of the capsule a -> b (radius r) on the vertical line at (qx, qy); -inf off it."""
+    low = -math.inf
+    for end in (a, b):
+        d2 = (qx - end[0]) ** 2 + (qy - end[1]) ** 2
+        if d2 <= r * r:
+            low = max(low, end[2] + math.sqrt(r * r - d2))
+    ux, uy, uz = b[0] - a[0], b[1] - a[1], b[2] - a[2]
+    length = math.sqrt(ux * ux + uy * uy + uz * uz)
+    if length > 0.0:
+        ux, uy, uz = ux / length, uy / length, uz / length
+        k = 1.0 - uz * uz
+        if k > vertical:
+            wx, wy = qx - a[0], qy - a[1]
+            s = wx * ux + wy * uy
+            disc = (s * uz) ** 2 - k * (wx * wx + wy * wy - s * s - r * r)
+            if disc >= 0.0:
+                z = (s * uz + math.sqrt(disc)) / k
+                t = s + z * uz
+                if 0.0 <= t <= length:
+                    low = max(low, a[2] + z)
+    return low
+
+
+@njit(cache=True)
+def _inside(qx, qy, polygon):
+    inside = False
+    n = polygon.shape[0]
+    for k in range(n):
+        x0, y0 = polygon[k, 0], polygon[k, 1]
+        x1, y1 = polygon[(k + 1) % n, 0], polygon[(k + 1) % n, 1]
+        if y0 != y1 and ((y0 > qy) != (y1 > qy)) and qx < x0 + (qy - y0) * (x1 - x0) / (y1 - y0):
+            inside = not inside
+    return inside
+
+
+@njit(cache=True)
+def _cell(layer, i, j):
+    if i < 0 or j < 0 or i >= layer.shape[0] or j >= layer.shape[1]:
+        return math.inf
+    return layer[i, j]
+
+
+@njit(cache=True)
+def _gap(layer, origin, cell, normal, i, k, x, y, c, s, ends, r, base, vertical):
+    """The gap of a capsule over cell (i, k); +inf when the cell's centre line misses it."""
+    cx, cy = origin[0] + (k + 0.5) * cell, origin[1] + (i + 0.5) * cell
+    dx, dy = cx - x, cy - y
+    low = capsule_lowest(c * dx + s * dy, -s * dx + c * dy, ends[0], ends[1], r, vertical)
+    if low == -math.inf:
+        return math.inf
+    return normal[0] * cx + normal[1] * cy + normal[2] * low + base - _cell(layer, i, k)
+
+
+@njit(cache=True)
+def _palm_gap(layer, origin, cell, normal, i, k, x, y, c, s, outline, base):
+    """The gap of the palm's underside (z = 0) over cell (i, k); +inf when the cell's centre is outside its outline."""
+    cx, cy = origin[0] + (k + 0.5) * cell, origin[1] + (i + 0.5) * cell
+    dx, dy = cx - x, cy - y
+    if not _inside(c * dx + s * dy, -s * dx + c * dy, outline):
+        return math.inf
+    return normal[0] * cx + normal[1] * cy + base - _cell(layer, i, k)
+
+
+@njit(cache=True)
+def clearances(layer, origin, cell, normal, poses, base, ends, radii, palm, vertical, out):
+    """Fill out (p, n_capsules + 1): per pose the least gap of each capsule (ends (n, 2, 3), radii (n,)) and the palm."""
+    nx_, ny_, nz_ = normal[0], normal[1], normal[2]
+    for p in range(poses.shape[0]):
+        x, y, c, s = poses[p, 0], poses[p, 1], math.cos(poses[p, 2]), math.sin(poses[p, 2])
+        for j in range(ends.shape[0] + 1):
+            capsule = j < ends.shape[0]
+            if capsule:
+                pts, r = ends[j], radii[j]
+            else:
+                pts, r = palm, 0.0
+            lo_x = lo_y = lowest = math.inf
+            hi_x = hi_y = -math.inf
+            for v in range(pts.shape[0]):
+                px, py = x + c * pts[v, 0] - s * pts[v, 1], y + s * pts[v, 0] + c * pts[v, 1]
+                lo_x, hi_x, lo_y, hi_y = min(lo_x, px), max(hi_x, px), min(lo_y, py), max(hi_y, py)
+                z = pts[v, 2] if capsule else 0.0
+                lowest = min(lowest, nx_ * px + ny_ * py + nz_ * z + base[p] - r)
+            c0 = int(math.floor((lo_x - r - origin[0]) / cell))
+            c1 = int(math.floor((hi_x + r - origin[0]) / cell))
+            r0 = int(math.floor((lo_y - r - origin[1]) / cell))
+            r1 = int(math.floor((hi_y + r - origin[1]) / cell))
+            least = math.inf
+            if capsule:  # start from the cell under the lower end: over a flat floor, the least gap at once
+                e = 0 if nz_ * pts[0, 2] + nx_ * (c * pts[0, 0] - s * pts[0, 1]) + ny_ * (s * pts[0, 0] + c * pts[0, 1]) \
+                    <= nz_ * pts[1, 2] + nx_ * (c * pts[1, 0] - s * pts[1, 1]) + ny_ * (s * pts[1, 0] + c * pts[1, 1]) else 1
+                ex, ey = x + c * pts[e, 0] - s * pts[e, 1], y + s * pts[e, 0] + c * pts[e, 1]
+                least = _gap(layer, origin, cell, normal, int(math.floor((ey - origin[1]) / cell)),
+                             int(math.floor((ex - origin[0]) / cell)), x, y, c, s, pts, r, base[p], vertical)
+            for i in range(r0, r1 + 1):
+                for k in range(c0, c1 + 1):
+                    if lowest - _cell(layer, i, k) >= least:
+                        continue
+                    if capsule:
+                        least = min(least, _gap(layer, origin, cell, normal, i, k, x, y, c, s, pts, r, base[p], vertical))
+                    else:
+                        least = min(least, _palm_gap(layer, origin, cell, normal, i, k, x, y, c, s, pts, base[p]))
+            out[p, j] = least
