@@ -21,19 +21,21 @@ Hand frame (``T_camera_hand``)
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+import sys
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from . import perception, validation
-from .errors import HandError, PerceptionError, PlannerError, SegmentationError
+from .errors import HandError, NoFeasibleGrasp, PerceptionError, PlannerError, SegmentationError
 from .hand import Hand
 from .perception import HeightMap, Intrinsics, MetricContour, Plane, Segmentation
 from .perception.camera import check_intrinsics
 from .synthesis import Descent, GraspPlan, search
 from .synthesis.grasp_height import grasp_height as choose_grasp_height
-from .tolerances import APPROACH_OFFSET, HOMOGENEOUS_ROW, MAX_APPROACH_OFFSET, MAX_STANDOFF, ROTATION_TOLERANCE
+from .tolerances import (APPROACH_OFFSET, HOMOGENEOUS_ROW, MAX_APPROACH_OFFSET, MAX_STANDOFF, ROTATION_TOLERANCE,
+                         SMALL_OBJECT_TOUCHING)
 
 SEGMENT_CHOICES = perception.SEGMENT_METHODS
 
@@ -114,6 +116,7 @@ def plan_frame(
     descent: bool = False,
     grasp_height: str | float | None = None,
     slice_contour: bool = False,
+    small_objects: bool = False,
     **synthesis_options,
 ) -> ImageGraspPlan:
     """Plan a grasp on one RGB-D frame with a :class:`~contourgrasp.hand.Hand`.
@@ -178,6 +181,13 @@ def plan_frame(
         With a planned grasp height: plan on the object's cross-section at that height
         (:func:`contourgrasp.perception.cross_section`) rather than its outline as seen, where the
         height map has one.
+    small_objects : bool
+        The small-object rule: when no pose satisfies the constraints with the hand's
+        ``min_touching`` fingers, plan again with fewer touching fingers, down to
+        ``tolerances.SMALL_OBJECT_TOUCHING`` (the thumb, or the hand's required fingers, against
+        two others): a one-DoF power grasp of a small object closes the whole hand, but only the
+        thumb and the fingers opposite it reach the object. The plan's ``hand`` has the
+        ``min_touching`` it was planned with, and its notes say so.
     **synthesis_options
         Keyword options of :func:`contourgrasp.synthesis.search`.
 
@@ -212,7 +222,7 @@ def plan_frame(
     if validation.flag("slice_contour", slice_contour, error=PlannerError) and asked is not None:
         section = perception.cross_section(heights, asked[0])
         contour = contour if section is None else section
-    plan = search(contour, hand, descent=spec, **synthesis_options)
+    plan = _search(contour, hand, spec, small_objects, synthesis_options)
     tip_height = None if asked is None else asked[0] if plan.descent is None else float(plan.descent.tip_height[0])
     depth_at = (metric.approach_depth if tip_height is None
                 else _palm_depth(metric, heights, hand, plan.pose, tip_height))
@@ -222,6 +232,23 @@ def plan_frame(
     T_base_hand = None if T_base_camera is None else T_base_camera @ T_camera_hand
     return ImageGraspPlan(plan, seg, metric, intrinsics, T_camera_hand, T_camera_pregrasp, T_base_hand, filled,
                           heights, *scene, grasp_height=tip_height)
+
+
+def _search(contour, hand: Hand, descent: Descent | None, small_objects, options) -> GraspPlan:
+    """:func:`~contourgrasp.synthesis.search`, with the small-object rule of :func:`plan_frame` when asked."""
+    try:
+        return search(contour, hand, descent=descent, **options)
+    except NoFeasibleGrasp:
+        fewest = max(SMALL_OBJECT_TOUCHING, sum(f.required for f in hand.fingers))
+        if not validation.flag("small_objects", small_objects, error=PlannerError) or hand.min_touching <= fewest:
+            raise
+        first = sys.exc_info()[1]
+    for touching in range(hand.min_touching - 1, fewest - 1, -1):
+        try:
+            return search(contour, replace(hand, min_touching=touching), descent=descent, **options)
+        except NoFeasibleGrasp:
+            continue
+    raise first
 
 
 def _grasp_height(hand: Hand, heights: HeightMap | None, descent, grasp_height) -> float | None:

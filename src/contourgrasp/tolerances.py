@@ -340,3 +340,7 @@ MAX_GRASP_HEIGHT_FRACTION = 0.7
 #: perception.cross_section: fewer object cells than this standing at the grasp height (m^2 / cell^2: 50 cells of
 #: 2 mm are 2 cm^2) is no section: the fingertips would close under the object's top on almost nothing.
 MIN_SECTION_CELLS = 50
+
+#: The small-object rule (pipeline.plan_frame(small_objects=True)): the fewest touching fingers it plans with (at
+#: least the hand's required ones): the thumb against two fingers. Chosen on ycb-train (README, "3-D hand").
+SMALL_OBJECT_TOUCHING = 2

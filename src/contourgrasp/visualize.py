@@ -17,11 +17,13 @@ from matplotlib.figure import Figure
 from mpl_toolkits.axes_grid1.anchored_artists import AnchoredSizeBar
 
 from . import contour as efd_model
-from .hand import to_image
+from .hand import chain_capsules, to_image
 from .synthesis import GraspPlan
 
 CONVEX_COLOUR = "0.25"
 CONCAVE_COLOUR = "tab:blue"
+#: Line width (points) of a finger's links in :func:`draw_side_view`.
+SIDE_VIEW_LINK_WIDTH = 4.0
 FINGER_COLOURS = ("tab:red", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink", "tab:olive")
 
 
@@ -149,6 +151,8 @@ def image_plan_figure(result, rgb=None) -> Figure:
 
     The third panel (:func:`draw_heights`) shows ``result.height_map`` under the planned
     hand's finger paths; without a height map (no table plane) the figure has the first two only.
+    With a planned grasp height and a 3-D hand a fourth (:func:`draw_side_view`) shows the open
+    hand at that height beside the scene's profile, seen along the hand's y axis.
 
     ``result`` is a :class:`contourgrasp.pipeline.ImageGraspPlan`; ``rgb`` the
     colour image (the depth-derived mask is shown when it is None). Over a
@@ -157,12 +161,16 @@ def image_plan_figure(result, rgb=None) -> Figure:
     """
     plan = result.plan
     heights = result.height_map
+    side = heights is not None and result.grasp_height is not None and plan.hand.is_3d
     if heights is None:
         fig = Figure(figsize=(16, 7), layout="constrained")
         image_ax, plan_ax = fig.subplots(1, 2, width_ratios=[1.2, 1])
-    else:
+    elif not side:
         fig = Figure(figsize=(22, 7), layout="constrained")
         image_ax, plan_ax, height_ax = fig.subplots(1, 3, width_ratios=[1.2, 1, 0.9])
+    else:
+        fig = Figure(figsize=(28, 7), layout="constrained")
+        image_ax, plan_ax, height_ax, side_ax = fig.subplots(1, 4, width_ratios=[1.2, 1, 0.9, 0.9])
     seg = result.segmentation
     image_ax.imshow(rgb if rgb is not None else seg.mask, cmap="gray")
     shift = np.asarray(seg.colour_offset_px if rgb is not None and seg.colour_offset_px is not None else (0, 0))
@@ -193,7 +201,51 @@ def image_plan_figure(result, rgb=None) -> Figure:
     plan_ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
     if heights is not None:
         draw_heights(height_ax, heights, plan, fig)
+    if side:
+        draw_side_view(side_ax, heights, plan, result.grasp_height)
     return fig
+
+
+def draw_side_view(ax, heights, plan: GraspPlan, grasp_height: float) -> None:
+    """The open 3-D hand at the grasp height beside the scene, seen along the hand's y axis.
+
+    Horizontal: the hand frame's x; vertical: height above the table. The scene is the highest
+    object (and obstacle) cell at each x over the whole map; each finger's post, proximal and
+    distal links are drawn as thick lines, the palm as a bar above its underside.
+    """
+    hand = plan.hand
+    x, y, yaw = plan.pose
+    xs, ys = heights.centres()
+    gx, gy = np.meshgrid(xs, ys)
+    along = math.cos(yaw) * (gx - x) + math.sin(yaw) * (gy - y)
+    palm_height = grasp_height + hand.open_tip_depth
+    for cells, colour, label in ((heights.object, "0.35", "object"), (heights.obstacles, "tab:gray", "obstacles")):
+        h = np.where(cells & np.isfinite(heights.heights), heights.heights, np.nan)
+        if not np.isfinite(h).any():
+            continue
+        bins = np.round(along / heights.cell).astype(int)
+        keys = bins[np.isfinite(h)]
+        top = np.full(keys.max() - keys.min() + 1, np.nan)
+        np.fmax.at(top, keys - keys.min(), h[np.isfinite(h)])
+        ax.fill_between((np.arange(len(top)) + keys.min()) * heights.cell, 0.0, top, color=colour, step="mid",
+                        alpha=0.7, label=label)
+    for i, (finger, chain) in enumerate(zip(hand.fingers, hand.chains)):
+        colour = FINGER_COLOURS[i % len(FINGER_COLOURS)]
+        for k, (a, b) in enumerate(chain_capsules(chain, 0.0)[0]):
+            ax.plot([a[0], b[0]], [palm_height - a[2], palm_height - b[2]], color=colour, alpha=0.8,
+                    lw=SIDE_VIEW_LINK_WIDTH, solid_capstyle="round", label=finger.name if k == 0 else None)
+    outline = hand.palm.points[:, 0]
+    ax.fill_between([outline.min(), outline.max()], palm_height, palm_height + hand.palm.thickness, color="0.2",
+                    label="palm")
+    ax.axhline(0.0, color="black", lw=1)
+    ax.axhline(grasp_height, color="tab:blue", ls=":", lw=1, label=f"grasp height {1e3 * grasp_height:.0f} mm")
+    ax.set_aspect("equal")
+    ax.set_xlabel("x along the hand [m]")
+    ax.set_ylabel("height above the table [m]")
+    least = "" if plan.descent is None else (f", least clearance {1e3 * float(plan.descent.clearance[0].min()):.1f} mm "
+                                              f"({plan.descent.bodies[int(np.argmin(plan.descent.clearance[0]))]})")
+    ax.set_title(f"side view of the open hand at the grasp{least}", fontsize=10)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
 
 
 def draw_heights(ax, heights, plan: GraspPlan | None = None, fig: Figure | None = None) -> None:

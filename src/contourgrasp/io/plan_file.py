@@ -77,8 +77,29 @@ def plan_to_dict(plan: GraspPlan) -> dict:
         "refinement": None if plan.refinement is None else {
             "grid_pose": _pose(plan.refinement.grid_pose), "grid_cost": plan.refinement.grid_cost,
             "cost": plan.refinement.cost, "gain": plan.refinement.gain},
+        "min_touching": plan.hand.min_touching,
+        "descent": descent_summary(plan.descent),
         "timing_ms": dict(plan.timing_ms),
         "notes": list(plan.notes),
+    }
+
+
+def descent_summary(check) -> dict | None:
+    """The plan file's entry of a plan's one-pose :class:`~contourgrasp.synthesis.DescentCheck`, None for None.
+
+    ``{tip_height, margin, clearance: {body: m}, least_clearance, blocking}``: the grasp height it was
+    checked at, and each finger's post, proximal and distal link's and the palm's least clearance
+    over the height map on the way down (m; null for a body over no cell).
+    """
+    if check is None:
+        return None
+    clearance = [float(c) if math.isfinite(c) else None for c in check.clearance[0]]
+    return {
+        "tip_height": float(check.tip_height[0]),
+        "margin": check.margin,
+        "clearance": dict(zip(check.bodies, clearance)),
+        "least_clearance": float(check.clearance[0].min()),
+        "blocking": None if check.blocking[0] < 0 else check.bodies[int(check.blocking[0])],
     }
 
 
@@ -144,6 +165,7 @@ def image_plan_to_dict(result) -> dict:
     data["target"] = {"label": None if result.target is None else result.target.label, "reason": result.target_reason}
     data["approach_depth"] = metric.approach_depth
     data["height_map"] = height_map_summary(result.height_map)
+    data["grasp_height"] = result.grasp_height
     data["T_camera_hand"] = result.T_camera_hand.tolist()
     data["quaternion_xyzw"] = result.quaternion_xyzw.tolist()
     data["T_camera_pregrasp"] = result.T_camera_pregrasp.tolist()

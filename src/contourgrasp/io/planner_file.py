@@ -27,6 +27,7 @@ which is the thesis's setting)::
     descent = false              # the open 3-D hand's descent onto the height map (synthesis.Descent)
     grasp_height = "clearance"   # or "auto", or a height in m (synthesis.grasp_height)
     slice_contour = false        # plan on the cross-section at the grasp height (perception.cross_section)
+    small_objects = false        # fewer touching fingers where no pose brings min_touching onto the object
 
 Unknown keys, wrong types and impossible values are refused with
 :class:`PlannerFileError` naming the file and the field; so is a file that is not UTF-8 text or
@@ -50,7 +51,7 @@ _PRESET_DIR = "data/planners"
 #: Options that belong to perception, and to planning in the scene's 3-D (the rest are
 #: :func:`contourgrasp.synthesis.search`'s).
 PERCEPTION_OPTIONS = ("depth_mode", "footprint")
-SCENE_OPTIONS = ("descent", "grasp_height", "slice_contour")
+SCENE_OPTIONS = ("descent", "grasp_height", "slice_contour", "small_objects")
 
 Positive = Annotated[float, Field(gt=0, le=tol.MAX_SEARCH_LENGTH, allow_inf_nan=False)]
 Distance = Annotated[float, Field(ge=0, le=tol.MAX_SEARCH_LENGTH, allow_inf_nan=False)]
@@ -78,6 +79,7 @@ class _PlannerSchema(BaseModel):
     quality_gain: NonNegative | None = None
     descent: bool | None = None
     slice_contour: bool | None = None
+    small_objects: bool | None = None
     grasp_height: (Literal["clearance", "auto"]
                    | Annotated[float, Field(ge=0, le=tol.MAX_HAND_SIZE, allow_inf_nan=False)] | None) = None
 

@@ -87,6 +87,9 @@ from ._descent_kernels import clearances
 #: Parts of a finger's chain, in the order of :func:`~contourgrasp.hand.chain_capsules`.
 FINGER_PARTS = ("post", "proximal", "distal")
 
+#: Clearances within this of the margin pass (m): a pose raised to exactly the margin keeps it up to rounding.
+_ROUNDING = 1e-9
+
 #: An axis with ``1 - u_z^2`` below this is vertical: its capsule's lowest points are its end balls'.
 _VERTICAL = 1e-12
 
@@ -242,7 +245,7 @@ def descent_feasible(hand: Hand, heights: HeightMap, poses, tip_height, *, margi
     margin = validation.bounded("margin", margin, MAX_HAND_SIZE, " m", error=PlannerError)
     clearance = descent_clearance(hand, heights, poses, tip_height)
     worst = clearance.argmin(axis=1) if clearance.size else np.zeros(0, dtype=int)
-    feasible = clearance.min(axis=1) >= margin if len(clearance) else np.zeros(0, dtype=bool)
+    feasible = clearance.min(axis=1) >= margin - _ROUNDING if len(clearance) else np.zeros(0, dtype=bool)
     tip = np.broadcast_to(np.asarray(tip_height, dtype=float), (len(clearance),)).copy()
     return DescentCheck(feasible=feasible, clearance=clearance, blocking=np.where(feasible, -1, worst),
                         bodies=body_names(hand), margin=margin, tip_height=tip)
