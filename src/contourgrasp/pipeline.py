@@ -21,7 +21,6 @@ Hand frame (``T_camera_hand``)
 from __future__ import annotations
 
 import math
-import sys
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -236,19 +235,20 @@ def plan_frame(
 
 def _search(contour, hand: Hand, descent: Descent | None, small_objects, options) -> GraspPlan:
     """:func:`~contourgrasp.synthesis.search`, with the small-object rule of :func:`plan_frame` when asked."""
+    small_objects = validation.flag("small_objects", small_objects, error=PlannerError)
+    fewest = max(SMALL_OBJECT_TOUCHING, sum(f.required for f in hand.fingers))
     try:
         return search(contour, hand, descent=descent, **options)
-    except NoFeasibleGrasp:
-        fewest = max(SMALL_OBJECT_TOUCHING, sum(f.required for f in hand.fingers))
-        if not validation.flag("small_objects", small_objects, error=PlannerError) or hand.min_touching <= fewest:
+    except NoFeasibleGrasp as err:
+        if not small_objects or hand.min_touching <= fewest:
             raise
-        first = sys.exc_info()[1]
+        first = str(err)
     for touching in range(hand.min_touching - 1, fewest - 1, -1):
         try:
             return search(contour, replace(hand, min_touching=touching), descent=descent, **options)
-        except NoFeasibleGrasp:
-            continue
-    raise first
+        except NoFeasibleGrasp as err:
+            last = str(err)
+    raise NoFeasibleGrasp(f"{first}; with the small-object rule, down to {fewest} touching fingers: {last}")
 
 
 def _grasp_height(hand: Hand, heights: HeightMap | None, descent, grasp_height) -> float | None:

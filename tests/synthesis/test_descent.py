@@ -6,10 +6,11 @@ import numpy as np
 import pytest
 
 from contourgrasp import load_hand
-from contourgrasp.errors import HandError, PerceptionError, PlannerError
+from contourgrasp.errors import HandError, NoFeasibleGrasp, PerceptionError, PlannerError
 from contourgrasp.hand import Hand, chain_tip
 from contourgrasp.perception import HeightMap
-from contourgrasp.synthesis.descent import body_names, descent_clearance, descent_feasible
+from contourgrasp.synthesis.descent import (Descent, body_names, check_candidates, descent_clearance, descent_feasible,
+                                            descent_floor)
 
 CELL = 0.002
 CAMERA = 0.7  # camera height above the table: a point at planning depth z is 0.7 - z above it
@@ -201,3 +202,60 @@ def test_bad_arguments_are_refused_by_name(hand):
     # a per-pose tip height is the same as one at a time
     both = descent_clearance(hand, hm, [[0, 0, 0], [0, 0, 1]], [0.01, 0.03])
     np.testing.assert_array_equal(both[1], descent_clearance(hand, hm, [[0, 0, 1]], 0.03)[0])
+
+
+def test_the_floor_is_the_tip_height_where_the_least_clearance_is_zero(hand):
+    heights = scene(lambda x, y: np.where(np.hypot(x, y) < 0.04, 0.08, 0.0))
+    poses = np.array([[0.0, 0.0, 0.3], [0.02, -0.01, 2.0], [0.2, 0.2, 1.0]])
+    floor = descent_floor(hand, heights, poses)
+    at_floor = descent_clearance(hand, heights, poses, floor).min(axis=1)
+    np.testing.assert_allclose(at_floor, 0.0, atol=1e-12)
+    assert floor[2] == pytest.approx(0.009, abs=1e-4)  # over the bare table: the lowest tips (9 mm) touch it
+
+
+def test_candidates_are_checked_in_order_and_raised_up_to_the_highest_accepted(hand):
+    heights = scene(rim)
+    clear = middle_pose(hand, EDGE, H, TIP, 0.002)
+    struck = middle_pose(hand, EDGE, H, TIP, -0.005)
+    poses = np.array([struck, clear, clear])
+    exact = Descent(heights, TIP, TIP, margin=0.001)
+    passed, tip, last = check_candidates(hand, exact, poses, [0, 1, 2])
+    assert passed.tolist() == [False, True, True] and tip[0] > TIP and tip[1] == TIP
+    raised = Descent(heights, TIP, TIP + 0.05, margin=0.001)
+    passed, tip, _ = check_candidates(hand, raised, poses, [0])
+    assert passed[0] and descent_feasible(hand, heights, poses[:1], tip[:1], margin=0.001).feasible[0]
+    np.testing.assert_allclose(descent_clearance(hand, heights, poses[:1], tip[:1]).min(), 0.001, atol=1e-12)
+    assert last is not None and not passed[:0].any()
+
+
+def test_the_search_keeps_the_open_hand_clear_of_a_tall_object(hand):
+    """A 12 cm column that the 2-D plan strikes: with the descent check the plan clears it by the margin."""
+    from contourgrasp import synthesis
+
+    r = 0.05
+    contour = np.c_[r * np.cos(np.linspace(0, 2 * np.pi, 200, endpoint=False)),
+                    r * np.sin(np.linspace(0, 2 * np.pi, 200, endpoint=False))]
+    heights = scene(lambda x, y: np.where(np.hypot(x, y) <= r, 0.12, 0.0))
+    options = dict(xy_step=0.01, yaw_step=math.radians(8))
+    flat = synthesis.search(contour, hand, **options)
+    assert descent_clearance(hand, heights, [flat.pose], 0.02).min() < 0  # the 2-D plan strikes
+    plan = synthesis.search(contour, hand, descent=Descent(heights, 0.02, 0.08), **options)
+    assert plan.descent.feasible[0] and plan.descent.clearance.min() >= plan.descent.margin - 1e-9
+    assert 0.02 <= plan.descent.tip_height[0] <= 0.08
+    with pytest.raises(NoFeasibleGrasp, match="strike the scene"):
+        synthesis.search(contour, hand, descent=Descent(heights, 0.02, 0.02, margin=0.3), **options)
+
+
+def test_descent_options_are_checked(hand):
+    heights = scene(rim)
+    with pytest.raises(PlannerError, match="below tip_height"):
+        Descent(heights, 0.05, 0.04)
+    with pytest.raises(PerceptionError, match="HeightMap"):
+        Descent("map", 0.05, 0.05)
+    with pytest.raises(PlannerError, match="descent must be"):
+        from contourgrasp import synthesis
+        synthesis.search(np.array([[0, 0], [0.05, 0], [0.05, 0.05]]), hand, descent="yes")
+    with pytest.raises(HandError, match="no 3-D geometry"):
+        from contourgrasp import synthesis
+        synthesis.search(np.array([[0, 0], [0.05, 0], [0.05, 0.05]]), load_hand("five-finger-curved-thumb"),
+                         descent=Descent(heights, 0.05, 0.05))

@@ -10,8 +10,10 @@ every reading at its own (x, y), whatever the perspective -- and returns their o
 Reading of the height map: a cell's height is the highest surface seen in its column, so "the
 object reaches this height here" is read as "its cross-section at this height covers the cell".
 That holds for objects whose sides do not overhang (boxes, cans, fruit, a lying bottle above its
-axis); under an overhang the camera cannot see the difference. Unseen object cells count as
-covered (they are inside the object's contour, hidden by the object itself).
+axis); under an overhang the camera cannot see the difference. Unseen cells do not count: inside
+the outline as seen, they are mostly the object's own occlusion shadow on the table (the visible side
+wall of a tall object, projected at its top, reaches over it), and where the section misses a hidden
+edge of the object, the descent check still sees the height map's bound there.
 """
 
 from __future__ import annotations
@@ -64,7 +66,7 @@ def cross_section(heights: HeightMap, height: float) -> np.ndarray | None:
         raise PerceptionError(f"heights must be a HeightMap, got {type(heights).__name__}")
     height = validation.bounded("height", height, MAX_HAND_SIZE, " m", error=PerceptionError)
     with np.errstate(invalid="ignore"):
-        covered = heights.object & (np.isnan(heights.heights) | (heights.heights >= height))
+        covered = heights.object & (heights.heights >= height)
     count, labels, stats, _ = cv2.connectedComponentsWithStats(covered.astype(np.uint8), connectivity=8)
     if count < 2:
         return None

@@ -1,0 +1,48 @@
+"""The grasp height rules against the hand's geometry."""
+
+import numpy as np
+import pytest
+
+from contourgrasp import load_hand
+from contourgrasp import tolerances as tol
+from contourgrasp.errors import PlannerError
+from contourgrasp.perception import HeightMap
+from contourgrasp.synthesis.grasp_height import grasp_height
+
+
+@pytest.fixture(scope="module")
+def hand():
+    return load_hand("five-finger-linear")
+
+
+def with_top(top):
+    grid = np.zeros((10, 10))
+    grid[4:6, 4:6] = top
+    return HeightMap(grid, 0.002, np.zeros(2), grid > 0, np.zeros((10, 10), bool), top, np.ones((10, 10), bool),
+                     np.array([0.0, 0.0, -1.0]), 0.7, np.zeros(2), 0.7)
+
+
+def test_clearance_keeps_the_closing_tips_just_above_the_table_for_a_low_object(hand):
+    low, high = grasp_height(hand, with_top(0.03), "clearance")
+    swing = hand.closing_tip_depth - hand.open_tip_depth
+    assert low == high == pytest.approx(max(c.radius for c in hand.chains) + tol.GRASP_TIP_CLEARANCE + swing)
+
+
+def test_clearance_keeps_the_palm_above_a_tall_objects_top(hand):
+    low, high = grasp_height(hand, with_top(0.2), "clearance")
+    assert low == high == pytest.approx(0.2 + tol.GRASP_PALM_CLEARANCE - hand.open_tip_depth)
+
+
+def test_auto_asks_a_fraction_of_the_height_and_accepts_up_to_a_larger_one(hand):
+    floor, _ = grasp_height(hand, with_top(0.02), "clearance")
+    assert grasp_height(hand, with_top(0.02), "auto") == pytest.approx((floor, floor))
+    low, high = grasp_height(hand, with_top(0.10), "auto")
+    assert low == pytest.approx(tol.GRASP_HEIGHT_FRACTION * 0.10)
+    assert high == pytest.approx(tol.MAX_GRASP_HEIGHT_FRACTION * 0.10)
+
+
+def test_a_number_is_the_height_itself_and_bad_rules_are_refused(hand):
+    assert grasp_height(hand, with_top(0.1), 0.05) == (0.05, 0.05)
+    for bad in ("high", -0.01, np.nan, 1e9):
+        with pytest.raises(PlannerError, match="grasp_height"):
+            grasp_height(hand, with_top(0.1), bad)
