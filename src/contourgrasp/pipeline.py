@@ -115,6 +115,7 @@ def plan_frame(
     descent: bool = False,
     grasp_height: str | float | None = None,
     slice_contour: bool = False,
+    closing_sweep: bool = False,
     small_objects: bool = False,
     **synthesis_options,
 ) -> ImageGraspPlan:
@@ -180,6 +181,9 @@ def plan_frame(
         With a planned grasp height: plan on the object's cross-section at that height
         (:func:`contourgrasp.perception.cross_section`) rather than its outline as seen, where the
         height map has one.
+    closing_sweep : bool
+        With ``descent``: also refuse a pose where a touching finger's chain would meet the scene
+        before its tip reaches its grasp point (:mod:`contourgrasp.synthesis.sweep`).
     small_objects : bool
         The small-object rule: when no pose satisfies the constraints with the hand's
         ``min_touching`` fingers, plan again with fewer touching fingers, down to
@@ -216,7 +220,8 @@ def plan_frame(
                                               target_px=target_px, roi=roi)
     heights = scene_heights(d, intrinsics, seg, metric, plane=table)
     asked = _grasp_height(hand, heights, descent, grasp_height)
-    spec = Descent(heights, *asked) if descent and asked is not None else None
+    sweep = validation.flag("closing_sweep", closing_sweep, error=PlannerError)
+    spec = Descent(heights, *asked, sweep=sweep) if descent and asked is not None else None
     contour = metric.contour_xy
     if validation.flag("slice_contour", slice_contour, error=PlannerError) and asked is not None:
         section = perception.cross_section(heights, asked[0])

@@ -344,3 +344,12 @@ MIN_SECTION_CELLS = 50
 #: The small-object rule (pipeline.plan_frame(small_objects=True)): the fewest touching fingers it plans with (at
 #: least the hand's required ones): the thumb against two fingers. Chosen on ycb-train (README, "3-D hand").
 SMALL_OBJECT_TOUCHING = 2
+
+#: Closing sweep (synthesis.sweep): closing progresses sampled per finger, and how much earlier than its tip's ball
+#: (radius + this, m) a finger's chain may meet the object before the pose counts as "a link touches first".
+SWEEP_SAMPLES = 12
+SWEEP_TOLERANCE = 0.005
+
+#: A capsule axis with 1 - u_z^2 below this is vertical (synthesis descent and sweep kernels): its lowest points
+#: on a vertical line are its end balls'.
+VERTICAL_AXIS = 1e-12

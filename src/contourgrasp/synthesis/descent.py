@@ -81,17 +81,15 @@ from .. import validation
 from ..errors import HandError, PerceptionError, PlannerError
 from ..hand import Hand, chain_capsules, chain_tip
 from ..perception.height_map import HeightMap
-from ..tolerances import DESCENT_BATCH, DESCENT_MARGIN, MAX_DESCENT_POSES, MAX_HAND_SIZE
+from ..tolerances import DESCENT_BATCH, DESCENT_MARGIN, MAX_DESCENT_POSES, MAX_HAND_SIZE, VERTICAL_AXIS
 from ._descent_kernels import clearances
+from .sweep import link_first
 
 #: Parts of a finger's chain, in the order of :func:`~contourgrasp.hand.chain_capsules`.
 FINGER_PARTS = ("post", "proximal", "distal")
 
 #: Clearances within this of the margin pass (m): a pose raised to exactly the margin keeps it up to rounding.
 _ROUNDING = 1e-9
-
-#: An axis with ``1 - u_z^2`` below this is vertical: its capsule's lowest points are its end balls'.
-_VERTICAL = 1e-12
 
 
 @dataclass(frozen=True, eq=False)
@@ -155,12 +153,16 @@ class Descent:
         The highest grasp height accepted, m (at least ``tip_height``; equal: no raising).
     margin : float
         Clearance every body keeps over the map, m (``tolerances.DESCENT_MARGIN``).
+    sweep : bool
+        Also refuse a pose where a touching finger's chain meets the scene before its tip reaches
+        its grasp point (:func:`~contourgrasp.synthesis.sweep.link_first`).
     """
 
     heights: HeightMap
     tip_height: float
     max_tip_height: float
     margin: float = DESCENT_MARGIN
+    sweep: bool = False
 
     def __post_init__(self):
         if not isinstance(self.heights, HeightMap):
@@ -170,6 +172,7 @@ class Descent:
         if self.max_tip_height < self.tip_height:
             raise PlannerError(f"max_tip_height ({self.max_tip_height:g} m) is below tip_height ({self.tip_height:g} m)")
         validation.bounded("margin", self.margin, MAX_HAND_SIZE, " m", error=PlannerError)
+        validation.flag("sweep", self.sweep, error=PlannerError)
 
 
 def body_names(hand: Hand) -> tuple[str, ...]:
@@ -212,18 +215,25 @@ def descent_clearance(hand: Hand, heights: HeightMap, poses, tip_height) -> np.n
     poses, tip, normal = _check_inputs(heights, poses, tip_height)
     ends = np.ascontiguousarray(np.concatenate([chain_capsules(c, 0.0)[0] for c in hand.chains]))  # (3n, 2, 3)
     radii = np.repeat([c.radius for c in hand.chains], 3).astype(float)
-    tips = np.array([chain_tip(c, 0.0)[0] for c in hand.chains])  # (n, 3)
-    # Height of a hand point at planning (x, y) and hand depth z: n_xy . (x, y) + n_z z + base, with base
-    # fixed by the lowest tip being at tip_height (the palm's planning depth cancels out).
-    c, s = np.cos(poses[:, 2])[:, None], np.sin(poses[:, 2])[:, None]
-    tip_x = poses[:, :1] + c * tips[None, :, 0] - s * tips[None, :, 1]
-    tip_y = poses[:, 1:2] + s * tips[None, :, 0] + c * tips[None, :, 1]
-    base = tip - (normal[0] * tip_x + normal[1] * tip_y + normal[2] * tips[None, :, 2]).min(axis=1)
+    base = height_base(hand, poses, tip, normal)
     out = np.empty((len(poses), len(ends) + 1))
     clearances(np.ascontiguousarray(heights.conservative(), dtype=float), np.asarray(heights.origin, dtype=float),
                float(heights.cell), normal, poses, base, ends, radii,
-               np.ascontiguousarray(hand.palm.points, dtype=float), _VERTICAL, out)
+               np.ascontiguousarray(hand.palm.points, dtype=float), VERTICAL_AXIS, out)
     return out
+
+
+def height_base(hand: Hand, poses, tip_height, normal) -> np.ndarray:
+    """(p,) float: per pose the offset b with which a hand point at planning (x, y) and hand depth z is
+    ``normal . (x, y, z) + b`` above the table, when the open hand's lowest tip is ``tip_height`` up.
+
+    The palm's planning depth cancels out: it is fixed by the lowest tip's height.
+    """
+    tips = np.array([chain_tip(c, 0.0)[0] for c in hand.chains])  # (n, 3)
+    c, s = np.cos(poses[:, 2])[:, None], np.sin(poses[:, 2])[:, None]
+    tip_x = poses[:, :1] + c * tips[None, :, 0] - s * tips[None, :, 1]
+    tip_y = poses[:, 1:2] + s * tips[None, :, 0] + c * tips[None, :, 1]
+    return tip_height - (normal[0] * tip_x + normal[1] * tip_y + normal[2] * tips[None, :, 2]).min(axis=1)
 
 
 def descent_feasible(hand: Hand, heights: HeightMap, poses, tip_height, *, margin: float = 0.0) -> DescentCheck:
@@ -262,7 +272,8 @@ def descent_floor(hand: Hand, heights: HeightMap, poses) -> np.ndarray:
     return -clearance.min(axis=1) if clearance.size else np.zeros(len(clearance))
 
 
-def check_candidates(hand: Hand, descent: Descent, poses, order) -> tuple[np.ndarray, np.ndarray, DescentCheck | None]:
+def check_candidates(hand: Hand, descent: Descent, poses, order, lam=None,
+                     touching=None) -> tuple[np.ndarray, np.ndarray, DescentCheck | None]:
     """The descent check of candidate poses in the given order, a batch at a time, until a batch has a feasible one.
 
     Parameters
@@ -272,6 +283,8 @@ def check_candidates(hand: Hand, descent: Descent, poses, order) -> tuple[np.nda
     poses : (p, 3) float
     order : (m,) int
         Indices into ``poses`` to check, best first.
+    lam, touching : (p, f) float and bool, optional
+        The poses' inner problem (:class:`~contourgrasp.synthesis.PoseEvaluation`), for ``descent.sweep``.
 
     Returns
     -------
@@ -297,9 +310,18 @@ def check_candidates(hand: Hand, descent: Descent, poses, order) -> tuple[np.nda
         raised = descent.tip_height + np.maximum(descent.margin - last.clearance.min(axis=1), 0.0)
         tip[rows] = raised
         passed[rows] = raised <= descent.max_tip_height
+        if descent.sweep and lam is not None:
+            passed[rows] &= ~_links_first(hand, descent.heights, poses[rows], raised, lam[rows], touching[rows])
         if passed[rows].any():
             break
     return passed, tip, last
+
+
+def _links_first(hand, heights, poses, tip, lam, touching) -> np.ndarray:
+    """(p,) bool: a touching finger's chain meets the map before its tip's grasp point (:func:`link_first`)."""
+    base = height_base(hand, poses, tip, np.asarray(heights.table_normal, dtype=float))
+    return np.array([link_first(hand, heights, pose, b, l, t).any()
+                     for pose, b, l, t in zip(poses, base, lam, touching)], dtype=bool)
 
 
 def _check_hand(hand) -> None:

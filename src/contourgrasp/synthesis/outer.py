@@ -157,7 +157,8 @@ def search(
                                step=(grid.xy_step, grid.yaw_step), d_max=grid.d_max,
                                curvature=curvature, d_min=grid.d_min, safeguards=safeguards)
         if descent is not None:
-            passed, _, _ = check_candidates(hand, descent, refined.poses, _by_cost(refined))
+            passed, _, _ = check_candidates(hand, descent, refined.poses, _by_cost(refined), refined.lam,
+                                            refined.touching)
             refined = replace(refined, feasible=refined.feasible & passed)
         result = concatenate(refined, result)
         ranked = distinct_best(result, grid, top_k)
@@ -220,7 +221,7 @@ def _reevaluate_best(model, hand, screen: PoseEvaluation, n: int, curvature, d_m
         if descent is not None and result.feasible.any():
             candidates = _by_cost(result)
             candidates = candidates[candidates >= checked]  # poses [0, checked) were checked before
-            passed, _, check = check_candidates(hand, descent, result.poses, candidates)
+            passed, _, check = check_candidates(hand, descent, result.poses, candidates, result.lam, result.touching)
             passed[:checked] = False
             last = check or last
             checked, descended = min(n, len(order)), descended + min(len(candidates), tol.MAX_DESCENT_POSES)
