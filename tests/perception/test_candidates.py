@@ -74,10 +74,12 @@ def test_nothing_on_the_table_gives_no_candidates():
     assert err.value.kind == "no-object"
 
 
-def test_default_target_is_the_largest_wholly_visible_candidate():
+def test_default_target_is_the_largest_wholly_visible_candidate_when_it_alone_is_of_its_size():
     found = candidates(scene(A, B, C))
     target, reason = choose_target(found)
-    assert target.bbox[:2] == A[:2] and "largest wholly visible" in reason
+    assert target.bbox[:2] == A[:2] and "fit the hand" in reason  # B (1600 px) is under half of A (6000 px)
+    largest, why = choose_target(found, rule="largest")
+    assert largest is target and "largest wholly visible" in why
     centre, why = choose_target(found, rule="centre")
     assert centre.bbox[:2] == A[:2] and "centre" in why  # A's centroid (349.5, 229.5) is nearer (319.5, 239.5)
     with pytest.raises(PerceptionError, match="rule"):
@@ -144,6 +146,7 @@ def test_plan_frame_plans_on_the_chosen_target_and_lists_the_candidates():
     data = image_plan_to_dict(chosen)
     assert [o["in_view"] for o in data["objects"]] == [False, True, True]
     assert data["objects"][2] == {"label": 3, "area_px": 1600, "height": pytest.approx(0.08, abs=1e-6),
+                                  "extent": pytest.approx([39 * 0.62 / 525] * 2, rel=1e-6),
                                   "centroid_px": [499.5, 319.5], "in_view": True, "bbox": [480, 300, 40, 40]}
     assert data["target"] == {"label": 3, "reason": "the candidate under pixel (490, 310)"}
     by_roi = plan_frame(None, depth, CAMERA, hand, roi=(470, 290, 20, 20), **FAST)
@@ -189,7 +192,8 @@ def test_cli_plan_on_the_bundled_frame_is_unchanged_and_reports_objects(tmp_path
     data = json.loads(out.read_text())
     assert data["pose"] == pytest.approx(MAIN_POSE, abs=1e-9)
     assert [o["in_view"] for o in data["objects"]] == [False, False, True]
-    assert data["target"]["label"] == 3 and "largest wholly visible" in data["target"]["reason"]
+    assert data["target"]["label"] == 3 and "fit the hand" in data["target"]["reason"]
+    assert data["support_surface"]["planes_considered"] == 1 and "dominant plane" in data["support_surface"]["reason"]
 
 
 @pytest.mark.parametrize(("args", "message"), [
