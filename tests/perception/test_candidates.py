@@ -86,6 +86,33 @@ def test_default_target_is_the_largest_wholly_visible_candidate_when_it_alone_is
         choose_target(found, rule="nearest")
 
 
+def test_default_rule_takes_the_candidate_nearest_the_centre_among_those_of_similar_size_that_fit_the_hand():
+    near = (330, 250, 60, 50, 0.04)  # 3000 px, centroid (359.5, 274.5)
+    far = (40, 40, 80, 50, 0.04)  # 4000 px, the largest, far from the centre
+    wide = (150, 380, 400, 60, 0.02)  # 24000 px, 0.52 m long and 0.076 m wide at 0.68 m
+    found = candidates(scene(near, far))
+    target, reason = choose_target(found, max_width=0.2)
+    assert target.bbox[:2] == near[:2] and "nearest the image centre among the 2" in reason
+    assert choose_target(found, rule="largest")[0].bbox[:2] == far[:2]
+    small = candidates(scene(far, (330, 250, 20, 20, 0.04)))  # 400 px: under half the largest, not a contender
+    assert choose_target(small, max_width=0.2)[0].bbox[:2] == far[:2]
+    with_wide = candidates(scene(near, wide))
+    assert with_wide[0].extent == pytest.approx((399 * 0.68 / 525, 59 * 0.68 / 525), rel=1e-6)
+    assert choose_target(with_wide, max_width=0.2)[0].bbox[:2] == wide[:2]  # 7.6 cm wide: fits, the near one is small
+    assert choose_target(with_wide, max_width=0.07)[0].bbox[:2] == near[:2]  # 6.2 cm wide; the wide one 7.6
+    none_fit, why = choose_target(with_wide, max_width=0.01)
+    assert none_fit.bbox[:2] == wide[:2] and "none is narrower than the hand's opening (10 mm)" in why
+    with pytest.raises(PerceptionError, match="max_width"):
+        choose_target(found, max_width=-1.0)
+
+
+def test_hand_opening_is_the_widest_distance_between_finger_starts():
+    hand = cg.load_hand("three-finger")
+    starts = hand.starts
+    assert cg.perception.hand_opening(hand) == pytest.approx(
+        max(np.linalg.norm(a - b) for a in starts for b in starts))
+
+
 def test_default_target_equals_todays_depth_segmentation():
     depth = scene(A, B, C)
     target, _ = choose_target(candidates(depth))

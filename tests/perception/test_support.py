@@ -1,0 +1,89 @@
+"""The support surface (issue 17): a bin's floor under the objects, not the conveyor with most pixels."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from contourgrasp.errors import SegmentationError
+from contourgrasp.perception import Support, find_support, fit_table_plane
+from contourgrasp.perception.camera import backproject
+
+from perception_scenes import CAMERA, H, W
+
+CONVEYOR, FLOOR, RIM = 0.80, 0.78, 0.70  # depths (m) of a top-down view: a bin 2 cm deep floor, 10 cm walls
+
+
+def bin_scene(*, objects=((250, 200, 60, 40, 0.05),), floor=(160, 120, 320, 240), wall_px=12):
+    """Depth of a bin on a conveyor: the conveyor fills the view, the bin's floor (x, y, w, h) is 2 cm above it,
+    its walls ``wall_px`` wide 10 cm; objects (x, y, w, h, height above the floor) stand on the floor."""
+    depth = np.full((H, W), CONVEYOR)
+    x, y, w, h = floor
+    depth[y - wall_px:y + h + wall_px, x - wall_px:x + w + wall_px] = RIM
+    depth[y:y + h, x:x + w] = FLOOR
+    for ox, oy, ow, oh, height in objects:
+        depth[oy:oy + oh, ox:ox + ow] = FLOOR - height
+    return depth
+
+
+def test_a_bins_floor_is_the_support_though_the_conveyor_has_more_pixels():
+    depth = bin_scene()
+    dominant = fit_table_plane(depth, CAMERA)
+    assert dominant.offset == pytest.approx(CONVEYOR, abs=1e-6)  # the plane with most pixels
+    support = find_support(depth, CAMERA)
+    assert isinstance(support, Support)
+    assert support.plane.offset == pytest.approx(FLOOR, abs=1e-6)
+    assert support.plane is not support.planes[0] and "parallel" in support.reason
+    inner = [c for c in support.candidates if c.in_view]
+    # on the floor: the object (2400 px) and the walls' ring, which the conveyor, below, does not join
+    assert sorted(c.area_px for c in inner) == [60 * 40, 344 * 264 - 320 * 240]
+    obj = next(c for c in inner if c.area_px == 2400)
+    assert obj.height == pytest.approx(0.05, abs=1e-6)
+
+
+def test_on_an_empty_table_the_dominant_plane_is_the_support():
+    depth = np.full((H, W), 0.7)
+    depth[200:260, 300:380] = 0.65
+    support = find_support(depth, CAMERA)
+    assert support.planes == (support.plane,) and support.plane.offset == pytest.approx(0.7, abs=1e-6)
+    assert [c.area_px for c in support.candidates] == [60 * 80]
+    empty = find_support(np.full((H, W), 0.7), CAMERA)
+    assert empty.candidates == () and "no plane holds" in empty.reason
+
+
+def test_a_higher_plane_that_holds_nothing_is_not_the_support():
+    depth = np.full((H, W), 0.7)
+    depth[:, :200] = 0.6  # a broad shelf at the left, 10 cm up: more than 5 % of the pixels, nothing on it
+    depth[200:260, 300:380] = 0.65
+    support = find_support(depth, CAMERA)
+    assert len(support.planes) == 2 and support.plane.offset == pytest.approx(0.7, abs=1e-6)
+
+
+def test_no_plane_is_one_line():
+    rng = np.random.default_rng(0)
+    with pytest.raises(SegmentationError) as err:
+        find_support(rng.uniform(0.3, 1.4, (H, W)), CAMERA)
+    assert err.value.kind == "no-plane" and "\n" not in str(err.value)
+
+
+def test_backproject_is_consistent_with_the_planes_offsets():
+    # the floor plane passes through the floor's points
+    depth = bin_scene()
+    support = find_support(depth, CAMERA)
+    points = backproject(depth, CAMERA)[200:210, 200:210].reshape(-1, 3)
+    np.testing.assert_allclose(support.plane.height(points), 0.0, atol=1e-6)
+
+
+def test_plan_frame_in_a_bin_plans_on_the_object_not_on_the_walls():
+    import math
+
+    import contourgrasp as cg
+    from contourgrasp.io.plan_file import image_plan_to_dict
+    from contourgrasp.pipeline import plan_frame
+
+    result = plan_frame(None, bin_scene(), CAMERA, cg.load_hand("three-finger"), xy_step=0.03, yaw_step=math.radians(6))
+    assert result.target.area_px == 2400 and result.segmentation.area_px == 2400
+    assert result.support.plane.offset == pytest.approx(FLOOR, abs=1e-6)
+    data = image_plan_to_dict(result)["support_surface"]
+    assert data["offset"] == pytest.approx(FLOOR, abs=1e-6) and data["planes_considered"] == 2
+    assert data["normal"] == pytest.approx([0, 0, -1], abs=1e-6) and data["inliers"] == 320 * 240 - 2400
