@@ -198,6 +198,26 @@ def plan_frame(
                           heights, *scene)
 
 
+def find_objects(depth, intrinsics: Intrinsics, *, fill_holes: bool = True) -> perception.Support:
+    """The support surface and every candidate on it, as :func:`plan_frame` finds them (``plan --all``).
+
+    The depth is checked and its small holes filled as in :func:`plan_frame`, so a candidate's
+    pixels here are its pixels there: ``plan_frame(target_px=...)`` at one of them plans on it.
+
+    Raises
+    ------
+    PerceptionError
+        Bad depth or intrinsics; no support plane (SegmentationError ``"no-plane"``).
+    """
+    check_intrinsics(intrinsics)
+    validation.flag("fill_holes", fill_holes, error=PerceptionError)
+    d = perception.as_depth(depth)
+    intrinsics.check_shape(d.shape, "depth image")
+    if fill_holes:
+        d, _ = perception.fill_depth_holes(d)
+    return perception.find_support(d, intrinsics)
+
+
 def perceive(
     rgb,
     depth,

@@ -120,6 +120,8 @@ SUPPORT_PARALLEL = _radians(10.0)
 SUPPORT_RING_FRACTION = 0.5
 #: ... a ring this wide (px).
 SUPPORT_RING_PX = 3
+#: ``plan --all`` plans at most this many objects (bounds the work a cluttered frame can ask for).
+MAX_ALL_OBJECTS = 16
 
 #: Smallest object, in pixels (about 2 x 2 cm at 0.7 m with a 525 px focal length).
 MIN_AREA_PX = 200

@@ -239,3 +239,66 @@ def test_cli_plan_refuses_bad_targets_in_one_line_writing_nothing(tmp_path, caps
     code, out, (stdout, stderr) = _plan(tmp_path, capsys, *args)
     assert code == 2 and not out.exists()
     assert message in stderr and len(stderr.strip().splitlines()) == 1
+
+
+def _scene_files(tmp_path, *boxes):
+    depth, intrinsics = tmp_path / "depth.npy", tmp_path / "camera.yaml"
+    np.save(depth, scene(*boxes))
+    intrinsics.write_text(f"fx: {CAMERA.fx}\nfy: {CAMERA.fy}\ncx: {CAMERA.cx}\ncy: {CAMERA.cy}\nwidth: {W}\nheight: {H}\n")
+    return ["plan", "--depth", str(depth), "--intrinsics", str(intrinsics), "--hand", "three-finger",
+            "--xy-step", "0.03", "--yaw-step-deg", "6"]
+
+
+def test_cli_plan_all_writes_a_plan_per_wholly_visible_object(tmp_path, capsys):
+    import json
+
+    args = _scene_files(tmp_path, A, B, C)
+    code = main([*args, "--all", "--out", str(tmp_path / "plan.json")])
+    stdout = capsys.readouterr().out
+    assert code == 0
+    written = sorted(p.name for p in tmp_path.glob("plan*.json"))
+    assert written == ["plan_2.json", "plan_3.json"]  # C (label 1) touches the border: an obstacle, not planned
+    for label in (2, 3):
+        data = json.loads((tmp_path / f"plan_{label}.json").read_text())
+        assert data["target"]["label"] == label and len(data["objects"]) == 3
+        assert f"object {label}: pose" in stdout
+    single = main([*args, "--target", "490,310", "--out", str(tmp_path / "one.json")])
+    assert single == 0
+    assert json.loads((tmp_path / "one.json").read_text())["pose"] == json.loads(
+        (tmp_path / "plan_3.json").read_text())["pose"]
+    capsys.readouterr()
+    assert main([*args, "--all"]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    assert [p["target"]["label"] for p in printed] == [2, 3]
+
+
+def test_cli_plan_all_skips_an_object_without_a_grasp_and_exits_3_when_none_has_one(tmp_path, capsys):
+    huge = (60, 60, 360, 360, 0.05)  # 0.45 x 0.45 m: wider than any hand opens
+    args = _scene_files(tmp_path, huge, B)
+    assert main([*args, "--all", "--out", str(tmp_path / "plan.json")]) == 0
+    err = capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.glob("plan*.json")) == ["plan_2.json"]
+    assert "contourgrasp: object 1: no feasible grasp" in err
+    (tmp_path / "only").mkdir()
+    only = _scene_files(tmp_path / "only", huge)
+    assert main([*only, "--all", "--out", str(tmp_path / "only" / "plan.json")]) == 3
+    assert not list((tmp_path / "only").glob("plan*.json"))
+    assert "none of the 1 wholly visible objects was planned" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("boxes", "extra", "message"), [
+    ((C, (600, 0, 40, 40, 0.05)), ["--all"], "not completely visible: every region on the support surface"),
+    ((C, (600, 0, 40, 40, 0.05)), [], "not completely visible"),
+    ((), ["--all"], "nothing stands on the support surface"),
+    ((A,), ["--target", "100,400"], "no object at pixel (100, 400); the nearest candidate is at (300, 259)"),
+    ((A,), ["--target=-1,5"], "pixel (-1, 5) is outside the 640x480 image"),
+    ((A,), ["--roi", "0,0,50,50"], "no candidate in the ROI (0, 0, 50, 50): nothing stands on the support surface"),
+    ((A,), ["--all", "--segment", "rgb"], "--all plans every depth candidate"),
+    ((A,), ["--all", "--target", "1,1"], "not allowed with argument"),
+])
+def test_cli_plan_bad_targets_are_one_line_exit_2_nothing_written(tmp_path, capsys, boxes, extra, message):
+    args = _scene_files(tmp_path, *boxes)
+    code = main([*args, *extra, "--out", str(tmp_path / "plan.json")])
+    err = capsys.readouterr().err
+    assert code == 2 and not list(tmp_path.glob("plan*"))
+    assert message in err and len(err.strip().splitlines()) == 1
