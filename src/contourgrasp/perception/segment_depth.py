@@ -17,7 +17,7 @@ from .. import validation
 from ..errors import PerceptionError
 from ..tolerances import (MAX_HOLE_PX, MIN_AREA_PX, MIN_HEIGHT, MIN_TABLE_HOLE_PX, PLANE_THRESHOLD, SENSOR_RANGE,
                           TILT_PLANE_THRESHOLD)
-from ._pixels import disc, in_image
+from ._pixels import disc, grown_box, in_image
 from .camera import Intrinsics, as_depth, check_intrinsics, fill_depth_holes, valid_depth
 from .region import Segmentation, make_segmentation, pick_object
 from .table import Plane, fit_table_plane, footprint_pixels, heights
@@ -188,18 +188,24 @@ def open_table_holes(mask, depth, intrinsics: Intrinsics, plane: Plane, *, min_p
     the table through the object and is object-free again. The outline is the outer one either
     way (:attr:`Segmentation.contour_px`), so this changes the mask, not the plan's contour.
     """
+    if not mask.any():
+        return mask
+    box = grown_box(mask, 1)  # holes lie inside the mask's box: the work is done there
+    m = mask[box]
     with np.errstate(invalid="ignore"):
-        on_plane = mask & valid_depth(depth) & (np.abs(heights(depth, intrinsics, plane)) < PLANE_THRESHOLD)
+        on_plane = m & valid_depth(depth[box]) & (np.abs(heights(depth, intrinsics, plane)[box]) < PLANE_THRESHOLD)
     if not on_plane.any():
         return mask
-    standing = mask & ~on_plane
+    standing = m & ~on_plane
     holes = ndimage.binary_fill_holes(standing) & ~standing
     count, labels = cv2.connectedComponents(holes.astype(np.uint8), connectivity=4)
     size = np.bincount(labels.ravel(), minlength=count)
     seen = np.bincount(labels.ravel(), weights=on_plane.ravel(), minlength=count)
     table = (size >= min_px) & (seen > 0.5 * size)
     table[0] = False
-    return mask & ~table[labels]
+    out = mask.copy()
+    out[box] &= ~table[labels]
+    return out
 
 
 def object_footprint(mask, depth, intrinsics: Intrinsics, plane: Plane) -> np.ndarray:

@@ -88,17 +88,18 @@ def find_support(depth, intrinsics: Intrinsics, *, min_height: float = MIN_HEIGH
     planes = (dominant, *_parallel_planes(d, intrinsics, dominant, depth_range, seed, min_height))
     options = {"min_height": min_height, "min_area_px": min_area_px, "depth_range": depth_range}
     valid = valid_depth(d, depth_range)
-    for rank, plane in enumerate(sorted(planes, key=lambda p: p.offset)):  # nearest the camera (highest) first
-        found = find_candidates(d, intrinsics, plane, **options)
-        held = [c for c in found if c.in_view and _stands_on(c, plane, valid)]
+    found = {}
+    for plane in sorted(planes, key=lambda p: p.offset):  # nearest the camera (highest) first
+        found[id(plane)] = find_candidates(d, intrinsics, plane, **options)
+        held = [c for c in found[id(plane)] if c.in_view and _stands_on(c, plane, valid)]
         if held:
             what = "the dominant plane" if plane is dominant else "a plane parallel to the dominant one"
             higher = f", the highest of {len(planes)} parallel planes holding one" if len(planes) > 1 else ""
-            return Support(plane, found, f"{what} (most pixels: {int(dominant.inliers.sum())}): "
-                                         f"{len(held)} wholly visible candidate(s) stand on it{higher}", planes)
-    found = find_candidates(d, intrinsics, dominant, **options)
-    return Support(dominant, found, "the dominant plane (most pixels): no plane holds a wholly visible candidate",
-                   planes)
+            return Support(plane, found[id(plane)], f"{what} (most pixels: {int(dominant.inliers.sum())}): "
+                                                    f"{len(held)} wholly visible candidate(s) stand on it{higher}",
+                           planes)
+    return Support(dominant, found[id(dominant)],
+                   "the dominant plane (most pixels): no plane holds a wholly visible candidate", planes)
 
 
 def _stands_on(candidate: Candidate, plane: Plane, valid) -> bool:
