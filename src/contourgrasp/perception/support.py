@@ -93,13 +93,18 @@ def find_support(depth, intrinsics: Intrinsics, *, min_height: float = MIN_HEIGH
         found[id(plane)] = find_candidates(d, intrinsics, plane, **options)
         held = [c for c in found[id(plane)] if c.in_view and _stands_on(c, plane, valid)]
         if held:
-            what = "the dominant plane" if plane is dominant else "a plane parallel to the dominant one"
-            higher = f", the highest of {len(planes)} parallel planes holding one" if len(planes) > 1 else ""
-            return Support(plane, found[id(plane)], f"{what} (most pixels: {int(dominant.inliers.sum())}): "
-                                                    f"{len(held)} wholly visible candidate(s) stand on it{higher}",
-                           planes)
+            return Support(plane, found[id(plane)], _reason(plane, dominant, len(held), len(planes)), planes)
     return Support(dominant, found[id(dominant)],
                    "the dominant plane (most pixels): no plane holds a wholly visible candidate", planes)
+
+
+def _reason(plane: Plane, dominant: Plane, held: int, planes: int) -> str:
+    """Why ``plane`` is the support, one line."""
+    what = (f"the dominant plane (most pixels: {int(dominant.inliers.sum())})" if plane is dominant else
+            f"a plane {1000 * (dominant.offset - plane.offset):.0f} mm above the dominant one "
+            f"(which has most pixels: {int(dominant.inliers.sum())}) and parallel to it")
+    among = f"; the highest such of the {planes} parallel planes found" if planes > 1 else ""
+    return f"{what}: {held} wholly visible candidate(s) stand on it{among}"
 
 
 def _stands_on(candidate: Candidate, plane: Plane, valid) -> bool:
