@@ -87,3 +87,51 @@ def test_plan_frame_in_a_bin_plans_on_the_object_not_on_the_walls():
     data = image_plan_to_dict(result)["support_surface"]
     assert data["offset"] == pytest.approx(FLOOR, abs=1e-6) and data["planes_considered"] == 2
     assert data["normal"] == pytest.approx([0, 0, -1], abs=1e-6) and data["inliers"] == 320 * 240 - 2400
+
+
+def tilted_bin(tilt_deg=8.8, distance=0.8, noise=0.001, missing=0.1, seed=0):
+    """Depth of a bin on a conveyor seen by a camera tilted ``tilt_deg`` about its x axis, with Gaussian noise
+    and a share of missing readings: heights above the conveyor of 0 (conveyor), 0.02 (the floor, 0.40 x 0.30 m),
+    0.12 (the walls, 2 cm thick) and 0.07 (a 8 x 5 cm object on the floor), as flat tops seen along each ray."""
+    t = np.radians(tilt_deg)
+    normal = np.array([0.0, np.sin(t), -np.cos(t)])  # toward the camera
+    u, v = np.meshgrid(np.arange(W), np.arange(H))
+    rays = np.stack([(u - CAMERA.cx) / CAMERA.fx, (v - CAMERA.cy) / CAMERA.fy, np.ones((H, W))], axis=-1)
+    x_axis = np.array([1.0, 0.0, 0.0])
+    y_axis = np.cross(normal, x_axis)
+    depth = np.full((H, W), np.inf)
+    centre = distance * np.array([0.0, 0.0, 1.0])  # where the optical axis meets the conveyor (height 0)
+
+    def top(height, half_x, half_y, inner=None):
+        # z of each ray where it meets the plane `height` above the conveyor, inside the box (minus `inner`)
+        z = (height + normal @ centre) / (rays @ normal)  # z (normal . ray) + offset = height
+        p = z[..., None] * rays - centre
+        x, y = p @ x_axis, p @ y_axis
+        inside = (np.abs(x) <= half_x) & (np.abs(y) <= half_y)
+        if inner is not None:
+            inside &= ~((np.abs(x) < inner[0]) & (np.abs(y) < inner[1]))
+        return np.where(inside, z, np.inf)
+
+    for layer in (top(0.0, 1e3, 1e3), top(0.02, 0.22, 0.17), top(0.12, 0.22, 0.17, inner=(0.20, 0.15)),
+                  top(0.07, 0.04, 0.025)):
+        depth = np.minimum(depth, layer)
+    rng = np.random.default_rng(seed)
+    depth = depth + rng.normal(0.0, noise, depth.shape)
+    depth[rng.random(depth.shape) < missing] = 0.0
+    return depth
+
+
+def test_a_tilted_noisy_bin_with_missing_readings_plans_on_the_object():
+    import math
+
+    import contourgrasp as cg
+    from contourgrasp.pipeline import plan_frame
+
+    depth = tilted_bin()
+    result = plan_frame(None, depth, CAMERA, cg.load_hand("three-finger"), xy_step=0.03, yaw_step=math.radians(6))
+    assert math.degrees(result.support.plane.tilt) == pytest.approx(8.8, abs=0.5)
+    assert "mm above the dominant one" in result.support.reason
+    conveyor = result.support.planes[0]
+    assert conveyor.offset - result.support.plane.offset == pytest.approx(0.02, abs=0.003)
+    assert result.target.height == pytest.approx(0.05, abs=0.005)  # the object's top above the floor
+    assert result.target.extent == pytest.approx((0.08, 0.05), abs=0.01)
