@@ -253,11 +253,12 @@ def test_cli_plan_all_writes_a_plan_per_wholly_visible_object(tmp_path, capsys):
     import json
 
     args = _scene_files(tmp_path, A, B, C)
-    code = main([*args, "--all", "--out", str(tmp_path / "plan.json")])
+    code = main([*args, "--all", "--out", str(tmp_path / "plan.json"), "--plot", str(tmp_path / "plan.png")])
     stdout = capsys.readouterr().out
     assert code == 0
-    written = sorted(p.name for p in tmp_path.glob("plan*.json"))
-    assert written == ["plan_2.json", "plan_3.json"]  # C (label 1) touches the border: an obstacle, not planned
+    written = sorted(p.name for p in tmp_path.glob("plan*"))
+    # C (label 1) touches the border: an obstacle, not planned
+    assert written == ["plan_2.json", "plan_2.png", "plan_3.json", "plan_3.png"]
     for label in (2, 3):
         data = json.loads((tmp_path / f"plan_{label}.json").read_text())
         assert data["target"]["label"] == label and len(data["objects"]) == 3
@@ -302,3 +303,11 @@ def test_cli_plan_bad_targets_are_one_line_exit_2_nothing_written(tmp_path, caps
     err = capsys.readouterr().err
     assert code == 2 and not list(tmp_path.glob("plan*"))
     assert message in err and len(err.strip().splitlines()) == 1
+
+
+def test_cli_plan_all_writes_all_or_nothing(tmp_path, capsys):
+    args = _scene_files(tmp_path, A, B, C)
+    (tmp_path / "plan_3.json").mkdir()  # the second object's plan cannot be written
+    assert main([*args, "--all", "--out", str(tmp_path / "plan.json")]) == 2
+    assert "plan_3.json: cannot write, it is a directory" in capsys.readouterr().err
+    assert not (tmp_path / "plan_2.json").exists()
