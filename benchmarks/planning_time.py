@@ -4,14 +4,18 @@ One simulated RGB-D frame per thesis object (seed 3, depth noise on), planned wi
 the `five-finger-linear` hand: perception, synthesis and the 6-DoF pose, exactly
 what a bench trial's planner does. Prints, per planner and object, the median
 wall time of 5 runs after a warm-up, and the synthesis's share (its
-``timing_ms.total``). One thread (set before numpy is imported).
+``timing_ms.total``). One thread (set before numpy is imported). ``--cpu``
+times the process's CPU time instead of the wall clock (steadier on a
+loaded machine); ``--real`` also plans the real frames with hand-made masks
+(``benchmarks/segmentation.py``'s, in ``../shared/data``), perception
+included.
 
 Usage::
 
-    .venv/bin/python benchmarks/planning_time.py [--planners paper,default] [--objects can,ycb:025_mug,...]
+    .venv/bin/python benchmarks/planning_time.py [--planners paper,default] [--cpu] [--real] [--objects ...]
 
 ``--objects`` takes the bench's object names (the thesis's five by default; ``ycb:<id>`` for a YCB
-object, ``ycb-train`` for the whole training split).
+object, ``ycb-train`` for the whole training split); a frame without a plan reads "nan ms".
 """
 
 import os
@@ -22,7 +26,10 @@ for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUM
 import argparse  # noqa: E402
 import math  # noqa: E402
 import statistics  # noqa: E402
+import sys  # noqa: E402
 import time  # noqa: E402
+import warnings  # noqa: E402
+from pathlib import Path  # noqa: E402
 
 import cv2  # noqa: E402
 
@@ -36,36 +43,57 @@ OBJECTS = ("can", "case", "bottle", "stone1", "stone2")
 RUNS, SEED = 5, 3
 
 
-def frame_times(planner: str, obj: str) -> tuple[float, float]:
-    """Median wall time of ``plan_grasp`` on one frame and its synthesis time, both ms (NaN: no plan)."""
+def simulated_frame(obj: str):
+    """(rgb, depth, intrinsics) of the simulated frame of ``obj`` (a bench object name, e.g. ``ycb:025_mug``)."""
     scene = build_scene(load_object(obj), seed=SEED)
-    rgb, depth = render(scene, noise=True, seed=SEED)
-    camera, hand = scene.camera.intrinsics, load_hand("five-finger-linear")
+    return (*render(scene, noise=True, seed=SEED), scene.camera.intrinsics)
+
+
+def frame_times(planner: str, frame, clock=time.perf_counter) -> tuple[float, float]:
+    """Median time (``clock``) of ``plan_frame`` on one (rgb, depth, intrinsics) frame and its synthesis time, ms."""
+    rgb, depth, camera = frame
+    hand = load_hand("five-finger-linear")
     options = load_planner(planner).plan_options
-    walls, synthesis = [], []
-    try:
-        pipeline.plan_frame(rgb, depth, camera, hand, **options)  # warm-up: numba's compilation, caches
-        for _ in range(RUNS):
-            start = time.perf_counter()
-            result = pipeline.plan_frame(rgb, depth, camera, hand, **options)
-            walls.append(1e3 * (time.perf_counter() - start))
-            synthesis.append(result.plan.timing_ms["total"])
-    except NoFeasibleGrasp:
-        return math.nan, math.nan
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        walls, synthesis = [], []
+        try:
+            pipeline.plan_frame(rgb, depth, camera, hand, **options)  # warm-up: numba's compilation, caches
+            for _ in range(RUNS):
+                start = clock()
+                result = pipeline.plan_frame(rgb, depth, camera, hand, **options)
+                walls.append(1e3 * (clock() - start))
+                synthesis.append(result.plan.timing_ms["total"])
+        except NoFeasibleGrasp:
+            return math.nan, math.nan
     return statistics.median(walls), statistics.median(synthesis)
+
+
+def real_frames() -> dict:
+    """name -> (rgb, depth, intrinsics) of the real frames with hand-made masks (none without the shared data)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from segmentation import default_data, frames
+
+    return {name.rsplit("/", 1)[-1]: (rgb, depth, intrinsics) for name, rgb, depth, intrinsics, _ in frames(default_data())}
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--planners", default="paper,default", help="comma list of planner names or files")
-    parser.add_argument("--objects", default=",".join(OBJECTS), help="comma list of bench object names or sets")
+    parser.add_argument("--cpu", action="store_true", help="CPU time of the process, not wall time")
+    parser.add_argument("--real", action="store_true", help="also the real frames of ../shared/data")
+    parser.add_argument("--objects", default=",".join(OBJECTS),
+                        help="comma list of bench object names or sets (e.g. ycb:025_mug, ycb-train)")
     args = parser.parse_args()
     cv2.setNumThreads(1)
-    objects = object_names(args.objects)
-    print("| planner | " + " | ".join(objects) + " |")
-    print("|---|" + "---:|" * len(objects))
+    clock = time.process_time if args.cpu else time.perf_counter
+    frames = {obj: simulated_frame(obj) for obj in object_names(args.objects)} | (real_frames() if args.real else {})
+    print(f"{'CPU' if args.cpu else 'wall'} time of plan_frame, median of {RUNS} (synthesis: its timing_ms.total, "
+          f"wall time)\n")
+    print("| planner | " + " | ".join(frames) + " |")
+    print("|---|" + "---:|" * len(frames))
     for planner in args.planners.split(","):
-        cells = [frame_times(planner, obj) for obj in objects]
+        cells = [frame_times(planner, frame, clock) for frame in frames.values()]
         print(f"| {planner} | " + " | ".join(f"{w:.0f} ms (synthesis {s:.0f})" for w, s in cells) + " |")
     print(f"\nload average at end: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
 

@@ -9,7 +9,11 @@ per frame. A refused frame (SegmentationError) scores IoU 0; a note in brackets
 says which method ``auto`` used (``depth``, ``depth+rgb`` or ``rgb``) and by how much
 it shifted the colour image onto the depth image (``Segmentation.colour_offset_px``).
 
-A second table scores ``auto`` against exact truth, on frames the simulation
+A second table (:func:`print_real_grey`) scores ``auto`` on the same frames with
+the colour image turned grey and stored as three equal channels (ITU-R 601
+luma), as a grayscale camera's driver stores it, against ``auto`` on colour.
+
+A third table scores ``auto`` against exact truth, on frames the simulation
 renders (:func:`contourgrasp.sim.render`, with its depth noise) of the five
 thesis objects and a dark grey tool with a flat plate
 (:func:`contourgrasp.sim.objects.flat_tool`), ``--sim-seeds`` placements each,
@@ -158,6 +162,7 @@ def main(argv=None) -> int:
     rows = list(frames(args.data))
     if rows:
         print_real(rows, args.repeat)
+        print_real_grey(rows)
     else:
         print(f"no frames with segmask_N.png found under {args.data}/rgbd: real frames skipped", file=sys.stderr)
     if args.sim_seeds > 0:
@@ -186,6 +191,27 @@ def print_real(rows, repeat) -> None:
     verdict = "met" if mean >= TARGET_MEAN and worst >= TARGET_WORST else "NOT met"
     print(f"\nauto (default): mean IoU {mean:.3f} (target >= {TARGET_MEAN}), worst {worst:.3f} "
           f"(target >= {TARGET_WORST}): target {verdict}")
+
+
+def grey(rgb) -> np.ndarray:
+    """(H, W, 3) uint8: ``rgb``'s luma (ITU-R 601) in three equal channels, as a grayscale camera stores it."""
+    luma = np.rint(np.asarray(rgb, dtype=float) @ [0.299, 0.587, 0.114]).astype(np.uint8)
+    return np.repeat(luma[..., None], 3, axis=2)
+
+
+def print_real_grey(rows) -> None:
+    """IoU of ``auto`` on the real frames in colour and in grey (three equal channels), per frame."""
+    print("\nThe same frames in grey (three equal channels): IoU of auto\n")
+    print("| frame | colour | grey | grey: method used |")
+    print("|---|---:|---:|---|")
+    scores = []
+    for name, rgb, depth, intrinsics, truth in rows:
+        colour, _, _ = run(rgb, depth, intrinsics, truth, "auto", None, 1)
+        gray, note, _ = run(grey(rgb), depth, intrinsics, truth, "auto", None, 1)
+        scores.append((colour, gray))
+        print(f"| {name} | {colour:.3f} | {gray:.3f} | {note} |")
+    mean = np.mean(scores, axis=0)
+    print(f"| **mean** | **{mean[0]:.3f}** | **{mean[1]:.3f}** | |")
 
 
 if __name__ == "__main__":

@@ -126,9 +126,15 @@ def _parser() -> argparse.ArgumentParser:
     plan.add_argument("--mask", help="binary image of the object: skips segmentation")
     target = plan.add_mutually_exclusive_group()
     target.add_argument("--target", type=_target_pixel, metavar="U,V",
-                        help="plan on the object under this depth pixel (default: the largest wholly visible one)")
+                        help="plan on the object under this depth pixel (default: of the wholly visible objects "
+                             "that fit the hand and are at least half as large as the largest, the one nearest "
+                             "the image centre)")
     target.add_argument("--roi", type=_roi, metavar="X,Y,W,H",
                         help="plan on the wholly visible object with most pixels in this box")
+    target.add_argument("--all", action="store_true",
+                        help="plan every wholly visible object: --out PLAN.json writes PLAN_<label>.json per "
+                             "object planned (--plot PLAN.png: PLAN_<label>.png), all or none; without --out the "
+                             "plans are printed as one JSON list; exit 0 when at least one object was planned")
     plan.add_argument("--depth-mode", choices=("max", "plane"),
                       help="contour plane: 'max' (thesis eq 3.1-3.2; the footprint on the table when the camera is "
                            "tilted) or the object's top 'plane' (default: the planner's)")
@@ -328,22 +334,20 @@ def _plan(args) -> int:
                                                         depth_scale=args.depth_scale)
     if frame.depth is None:
         raise InputError("plan needs --depth and --intrinsics, or --bag")
-    result = plan_frame(
-        frame.rgb,
-        frame.depth,
-        frame.intrinsics,
-        load_hand(args.hand),
-        segment=args.segment,
-        mask=frame.mask,
-        fill_holes=not args.no_fill_holes,
-        colour_offset_px=args.colour_offset,
-        approach_offset=args.approach_offset,
-        standoff=args.standoff,
-        T_base_camera=None if args.extrinsics is None else read_extrinsics(args.extrinsics),
-        target_px=args.target,
-        roi=args.roi,
+    options = {
+        "segment": args.segment,
+        "mask": frame.mask,
+        "fill_holes": not args.no_fill_holes,
+        "colour_offset_px": args.colour_offset,
+        "approach_offset": args.approach_offset,
+        "standoff": args.standoff,
+        "T_base_camera": None if args.extrinsics is None else read_extrinsics(args.extrinsics),
         **_plan_options(args),
-    )
+    }
+    if args.all:
+        return _plan_all(args, frame, options)
+    result = plan_frame(frame.rgb, frame.depth, frame.intrinsics, load_hand(args.hand), target_px=args.target,
+                        roi=args.roi, **options)
 
     def figure():
         from .visualize import image_plan_figure
@@ -352,6 +356,61 @@ def _plan(args) -> int:
 
     _write_outputs(args, image_plan_to_dict(result), figure, _summary(result.plan))
     return EXIT_OK
+
+
+def _plan_all(args, frame, options) -> int:
+    """``plan --all``: a plan per wholly visible candidate, written all or none (naming in ``--help``)."""
+    from .io.plan_file import image_plan_to_dict
+    from .perception import choose_target
+    from .pipeline import find_objects, plan_frame
+    from .tolerances import MAX_ALL_OBJECTS
+
+    if frame.mask is not None or args.segment == "rgb":
+        raise InputError("--all plans every depth candidate: not with --mask or --segment rgb")
+    candidates = find_objects(frame.depth, frame.intrinsics, fill_holes=options["fill_holes"]).candidates
+    choose_target(candidates)  # refuses, in one line, an empty scene or one whose every region touches the border
+    inner = [c for c in candidates if c.in_view]
+    if len(inner) > MAX_ALL_OBJECTS:
+        raise InputError(f"--all would plan {len(inner)} objects, at most {MAX_ALL_OBJECTS}: choose with --roi")
+    hand, planned, failed = load_hand(args.hand), [], []
+    for c in inner:
+        rows, cols = np.nonzero(c.mask)  # plan_frame finds the same candidates: any of its pixels names it
+        pixel = (int(cols[len(cols) // 2]), int(rows[len(rows) // 2]))
+        try:
+            planned.append((c.label, plan_frame(frame.rgb, frame.depth, frame.intrinsics, hand, target_px=pixel,
+                                                **options)))
+        except NoFeasibleGrasp as err:
+            failed.append((c.label, EXIT_INFEASIBLE, f"no feasible grasp: {err.reason}"))
+        except InputError as err:
+            failed.append((c.label, EXIT_INPUT, f"error: {err}"))
+    for label, _, why in failed:
+        print(f"contourgrasp: object {label}: {why}", file=sys.stderr)
+    if not planned:
+        code = EXIT_INFEASIBLE if any(code == EXIT_INFEASIBLE for _, code, _ in failed) else EXIT_INPUT
+        print(f"contourgrasp: none of the {len(inner)} wholly visible objects was planned", file=sys.stderr)
+        return code
+    outs = [None if args.out is None else _numbered(args.out, label, ".json") for label, _ in planned]
+    plots = [None if args.plot is None else _numbered(args.plot, label, ".png") for label, _ in planned]
+    with atomic_outputs(*outs, *plots, inputs=_inputs(args)) as paths:
+        for (label, result), out, plot in zip(planned, paths[:len(planned)], paths[len(planned):], strict=True):
+            if out is not None:
+                write_json(image_plan_to_dict(result), out)
+            if plot is not None:
+                from .visualize import image_plan_figure
+
+                image_plan_figure(result, frame.rgb).savefig(plot, dpi=110, format="png")
+    if args.out is None:
+        print(json.dumps([image_plan_to_dict(result) for _, result in planned], indent=2))
+    else:
+        for (label, result), out in zip(planned, outs, strict=True):
+            print(f"object {label}: {_summary(result.plan)} -> {out}")
+    return EXIT_OK
+
+
+def _numbered(path: str, label: int, suffix: str) -> Path:
+    """``PLAN.json`` -> ``PLAN_<label>.json`` (``suffix`` when the name has none)."""
+    p = Path(path)
+    return p.with_name(f"{p.stem}_{label}{p.suffix or suffix}")
 
 
 def _bag_frame(args):

@@ -69,6 +69,9 @@ class ImageGraspPlan:
         object did not come from the depth candidates (the RGB method found it) and overlaps none.
     target_reason : str
         Why that object was planned on, one line.
+    support : Support or None
+        The support surface and how it was chosen (:func:`contourgrasp.perception.find_support`);
+        None when depth found no plane.
     grasp_height : float or None
         Height above the table of the open hand's lowest fingertip at ``T_camera_hand``, m, when
         the planner chose it (``plan_frame(descent=...)`` or ``grasp_height=...``); None when the
@@ -87,6 +90,7 @@ class ImageGraspPlan:
     candidates: tuple = ()
     target: perception.Candidate | None = None
     target_reason: str = ""
+    support: perception.Support | None = None
     grasp_height: float | None = None
 
     @property
@@ -162,8 +166,10 @@ def plan_frame(
         Plan on the object under this pixel (u, v) of the depth image.
     roi : (int, int, int, int), optional
         Plan on the wholly visible object with most pixels in this box (x, y, w, h).
-        Without ``target_px`` and ``roi`` the object is the largest wholly visible region
-        standing on the table, as always (:func:`contourgrasp.perception.choose_target`);
+        Without ``target_px`` and ``roi`` the object is chosen by the default ``"hand"`` rule of
+        :func:`contourgrasp.perception.choose_target`: of the wholly visible candidates narrower than
+        the hand's opening and at least half as large as the largest of them, the one nearest the
+        image centre (with one object in view: the largest wholly visible region, as always);
         regions touching the image border are listed in ``candidates`` but never chosen.
         Both need depth segmentation (not ``mask`` or ``segment="rgb"``).
     descent : bool
@@ -217,7 +223,8 @@ def plan_frame(
     seg, metric, filled, d, table, scene = _perceive(rgb, depth, intrinsics, segment=segment, mask=mask, depth_mode=depth_mode,
                                               footprint=footprint, fill_holes=fill_holes,
                                               colour_offset_px=colour_offset_px, approach_offset=approach_offset,
-                                              target_px=target_px, roi=roi)
+                                              target_px=target_px, roi=roi,
+                                              max_width=perception.hand_opening(hand))
     heights = scene_heights(d, intrinsics, seg, metric, plane=table)
     asked = _grasp_height(hand, heights, descent, grasp_height)
     sweep = validation.flag("closing_sweep", closing_sweep, error=PlannerError)
@@ -275,6 +282,26 @@ def _palm_depth(metric: MetricContour, heights: HeightMap, hand: Hand, pose, tip
     return float(z + metric.R_camera_plane[:, 2] @ metric.origin)
 
 
+def find_objects(depth, intrinsics: Intrinsics, *, fill_holes: bool = True) -> perception.Support:
+    """The support surface and every candidate on it, as :func:`plan_frame` finds them (``plan --all``).
+
+    The depth is checked and its small holes filled as in :func:`plan_frame`, so a candidate's
+    pixels here are its pixels there: ``plan_frame(target_px=...)`` at one of them plans on it.
+
+    Raises
+    ------
+    PerceptionError
+        Bad depth or intrinsics; no support plane (SegmentationError ``"no-plane"``).
+    """
+    check_intrinsics(intrinsics)
+    validation.flag("fill_holes", fill_holes, error=PerceptionError)
+    d = perception.as_depth(depth)
+    intrinsics.check_shape(d.shape, "depth image")
+    if fill_holes:
+        d, _ = perception.fill_depth_holes(d)
+    return perception.find_support(d, intrinsics)
+
+
 def perceive(
     rgb,
     depth,
@@ -298,10 +325,15 @@ def perceive(
 
 
 def _perceive(rgb, depth, intrinsics, *, segment, mask, depth_mode, footprint, fill_holes, colour_offset_px,
-              approach_offset, target_px=None, roi=None):
-    """:func:`perceive`, the depth image it worked on (holes filled), the table plane (None if there is
-    none: fitted once here and shared by segmentation, the metric contour and the height map), and
-    (candidates, target, reason)."""
+              approach_offset, target_px=None, roi=None, max_width=None):
+    """:func:`perceive`, the depth image it worked on (holes filled), the support plane (None if there is
+    none: found once here, :func:`contourgrasp.perception.find_support`, and shared by segmentation, the
+    metric contour and the height map), and (candidates, target, reason, support).
+
+    Without ``target_px`` and ``roi`` the target is chosen by the ``"hand"`` rule of
+    :func:`contourgrasp.perception.choose_target` (``max_width``: the hand's opening); when that is
+    the largest wholly visible candidate, segmentation picks it itself (the same region, and its
+    warnings), else it is handed to segmentation as the target."""
     _check_options(intrinsics, segment, depth_mode, footprint, fill_holes, colour_offset_px, approach_offset)
     chosen = target_px is not None or roi is not None
     if target_px is not None and roi is not None:
@@ -323,42 +355,39 @@ def _perceive(rgb, depth, intrinsics, *, segment, mask, depth_mode, footprint, f
     if mask is not None:
         intrinsics.check_shape(np.shape(mask), "mask")
     try:
-        plane = perception.fit_table_plane(d, intrinsics)
+        support = perception.find_support(d, intrinsics)
     except SegmentationError:
         if chosen:
             raise
-        plane = None
-    candidates = () if plane is None else perception.find_candidates(d, intrinsics, plane)
+        support = None
+    plane = None if support is None else support.plane
+    candidates = () if support is None else support.candidates
     target, reason = None, ""
     if chosen:
         target, reason = perception.choose_target(candidates, target_px=target_px, roi=roi)
+    elif mask is None and segment != "rgb" and any(c.in_view for c in candidates):
+        target, reason = perception.choose_target(candidates, max_width=max_width)
     if mask is not None:
         seg = perception.segment_from_mask(mask)
     else:
         options = {"footprint": False if depth_mode == "plane" else footprint}
         if plane is not None and segment != "rgb":
             options["plane"] = plane  # the same fit segmentation would make
-        if target is not None:
-            options["target"] = target.mask
+        if target is not None and (chosen or target is not next(c for c in candidates if c.in_view)):
+            options["target"] = target.mask  # else segmentation's own pick, the largest wholly visible region
         seg = perception.segment(rgb, d, intrinsics, method=segment, colour_offset_px=colour_offset_px,
                                  depth_options=options)
-    if target is None:
+    if mask is not None or seg.method == "rgb":
         target, reason = _found_target(candidates, seg, mask is not None)
     metric = perception.contour_to_metric(
         seg.contour_px, d, intrinsics, depth_mode=depth_mode, plane=plane if seg.plane is None else seg.plane,
         on_table=seg.on_table, offset=approach_offset,
     )
-    return seg, metric, filled, d, plane, (candidates, target, reason)
+    return seg, metric, filled, d, plane, (candidates, target, reason, support)
 
 
 def _found_target(candidates, seg: Segmentation, user_mask: bool):
-    """The candidate the default segmentation planned on, and why: the largest wholly visible one
-    (depth, the rule of :func:`contourgrasp.perception.choose_target`), else the one the mask or the
-    RGB region overlaps most (None when it overlaps none)."""
-    if not user_mask and seg.method != "rgb":
-        inner = [c for c in candidates if c.in_view]
-        if inner:
-            return perception.choose_target(candidates)
+    """The candidate a user's mask or the RGB method's region overlaps most, and why (None when it overlaps none)."""
     overlap = [(int((c.mask & seg.mask).sum()), c) for c in candidates]
     n, best = max(overlap, key=lambda item: item[0], default=(0, None))
     what = "the user's mask" if user_mask else f"the region found by the {seg.method} method"

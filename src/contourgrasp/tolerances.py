@@ -109,6 +109,22 @@ TILT_PLANE_THRESHOLD = _radians(2.0)
 #: Above this tilt (rad) a warning says the top-down assumption is stretched.
 TILT_WARN = _radians(20.0)
 
+# The support surface (perception.support, issue 17): a table or a bin's floor.
+#: Planes considered, the dominant one included.
+SUPPORT_PLANES = 3
+#: A further plane holds at least this fraction of the valid depth pixels.
+MIN_SUPPORT_FRACTION = 0.05
+#: A further plane's normal lies within this angle (rad) of the dominant plane's.
+SUPPORT_PARALLEL = _radians(10.0)
+#: A candidate stands on a plane when this fraction of the valid pixels in a ring around it lie on the plane ...
+SUPPORT_RING_FRACTION = 0.5
+#: ... a ring this wide (px).
+SUPPORT_RING_PX = 3
+#: A hole in an object's mask of at least this many pixels that sees the support surface is object-free.
+MIN_TABLE_HOLE_PX = 20
+#: ``plan --all`` plans at most this many objects (bounds the work a cluttered frame can ask for).
+MAX_ALL_OBJECTS = 16
+
 #: Smallest object, in pixels (about 2 x 2 cm at 0.7 m with a 525 px focal length).
 MIN_AREA_PX = 200
 

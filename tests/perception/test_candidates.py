@@ -74,14 +74,43 @@ def test_nothing_on_the_table_gives_no_candidates():
     assert err.value.kind == "no-object"
 
 
-def test_default_target_is_the_largest_wholly_visible_candidate():
+def test_default_target_is_the_largest_wholly_visible_candidate_when_it_alone_is_of_its_size():
     found = candidates(scene(A, B, C))
     target, reason = choose_target(found)
-    assert target.bbox[:2] == A[:2] and "largest wholly visible" in reason
+    assert target.bbox[:2] == A[:2] and "fit the hand" in reason  # B (1600 px) is under half of A (6000 px)
+    largest, why = choose_target(found, rule="largest")
+    assert largest is target and "largest wholly visible" in why
     centre, why = choose_target(found, rule="centre")
     assert centre.bbox[:2] == A[:2] and "centre" in why  # A's centroid (349.5, 229.5) is nearer (319.5, 239.5)
     with pytest.raises(PerceptionError, match="rule"):
         choose_target(found, rule="nearest")
+
+
+def test_default_rule_takes_the_candidate_nearest_the_centre_among_those_of_similar_size_that_fit_the_hand():
+    near = (330, 250, 60, 50, 0.04)  # 3000 px, centroid (359.5, 274.5)
+    far = (40, 40, 80, 50, 0.04)  # 4000 px, the largest, far from the centre
+    wide = (150, 380, 400, 60, 0.02)  # 24000 px, 0.52 m long and 0.076 m wide at 0.68 m
+    found = candidates(scene(near, far))
+    target, reason = choose_target(found, max_width=0.2)
+    assert target.bbox[:2] == near[:2] and "nearest the image centre among the 2" in reason
+    assert choose_target(found, rule="largest")[0].bbox[:2] == far[:2]
+    small = candidates(scene(far, (330, 250, 20, 20, 0.04)))  # 400 px: under half the largest, not a contender
+    assert choose_target(small, max_width=0.2)[0].bbox[:2] == far[:2]
+    with_wide = candidates(scene(near, wide))
+    assert with_wide[0].extent == pytest.approx((399 * 0.68 / 525, 59 * 0.68 / 525), rel=1e-6)
+    assert choose_target(with_wide, max_width=0.2)[0].bbox[:2] == wide[:2]  # 7.6 cm wide: fits, the near one is small
+    assert choose_target(with_wide, max_width=0.07)[0].bbox[:2] == near[:2]  # 6.2 cm wide; the wide one 7.6
+    none_fit, why = choose_target(with_wide, max_width=0.01)
+    assert none_fit.bbox[:2] == wide[:2] and "none is narrower than the hand's opening (10 mm)" in why
+    with pytest.raises(PerceptionError, match="max_width"):
+        choose_target(found, max_width=-1.0)
+
+
+def test_hand_opening_is_the_widest_distance_between_finger_starts():
+    hand = cg.load_hand("three-finger")
+    starts = hand.starts
+    assert cg.perception.hand_opening(hand) == pytest.approx(
+        max(np.linalg.norm(a - b) for a in starts for b in starts))
 
 
 def test_default_target_equals_todays_depth_segmentation():
@@ -144,6 +173,7 @@ def test_plan_frame_plans_on_the_chosen_target_and_lists_the_candidates():
     data = image_plan_to_dict(chosen)
     assert [o["in_view"] for o in data["objects"]] == [False, True, True]
     assert data["objects"][2] == {"label": 3, "area_px": 1600, "height": pytest.approx(0.08, abs=1e-6),
+                                  "extent": pytest.approx([39 * 0.62 / 525] * 2, rel=1e-6),
                                   "centroid_px": [499.5, 319.5], "in_view": True, "bbox": [480, 300, 40, 40]}
     assert data["target"] == {"label": 3, "reason": "the candidate under pixel (490, 310)"}
     by_roi = plan_frame(None, depth, CAMERA, hand, roi=(470, 290, 20, 20), **FAST)
@@ -189,7 +219,8 @@ def test_cli_plan_on_the_bundled_frame_is_unchanged_and_reports_objects(tmp_path
     data = json.loads(out.read_text())
     assert data["pose"] == pytest.approx(MAIN_POSE, abs=1e-9)
     assert [o["in_view"] for o in data["objects"]] == [False, False, True]
-    assert data["target"]["label"] == 3 and "largest wholly visible" in data["target"]["reason"]
+    assert data["target"]["label"] == 3 and "fit the hand" in data["target"]["reason"]
+    assert data["support_surface"]["planes_considered"] == 1 and "dominant plane" in data["support_surface"]["reason"]
 
 
 @pytest.mark.parametrize(("args", "message"), [
@@ -208,3 +239,75 @@ def test_cli_plan_refuses_bad_targets_in_one_line_writing_nothing(tmp_path, caps
     code, out, (stdout, stderr) = _plan(tmp_path, capsys, *args)
     assert code == 2 and not out.exists()
     assert message in stderr and len(stderr.strip().splitlines()) == 1
+
+
+def _scene_files(tmp_path, *boxes):
+    depth, intrinsics = tmp_path / "depth.npy", tmp_path / "camera.yaml"
+    np.save(depth, scene(*boxes))
+    intrinsics.write_text(f"fx: {CAMERA.fx}\nfy: {CAMERA.fy}\ncx: {CAMERA.cx}\ncy: {CAMERA.cy}\nwidth: {W}\nheight: {H}\n")
+    return ["plan", "--depth", str(depth), "--intrinsics", str(intrinsics), "--hand", "three-finger",
+            "--xy-step", "0.03", "--yaw-step-deg", "6"]
+
+
+def test_cli_plan_all_writes_a_plan_per_wholly_visible_object(tmp_path, capsys):
+    import json
+
+    args = _scene_files(tmp_path, A, B, C)
+    code = main([*args, "--all", "--out", str(tmp_path / "plan.json"), "--plot", str(tmp_path / "plan.png")])
+    stdout = capsys.readouterr().out
+    assert code == 0
+    written = sorted(p.name for p in tmp_path.glob("plan*"))
+    # C (label 1) touches the border: an obstacle, not planned
+    assert written == ["plan_2.json", "plan_2.png", "plan_3.json", "plan_3.png"]
+    for label in (2, 3):
+        data = json.loads((tmp_path / f"plan_{label}.json").read_text())
+        assert data["target"]["label"] == label and len(data["objects"]) == 3
+        assert f"object {label}: pose" in stdout
+    single = main([*args, "--target", "490,310", "--out", str(tmp_path / "one.json")])
+    assert single == 0
+    assert json.loads((tmp_path / "one.json").read_text())["pose"] == json.loads(
+        (tmp_path / "plan_3.json").read_text())["pose"]
+    capsys.readouterr()
+    assert main([*args, "--all"]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    assert [p["target"]["label"] for p in printed] == [2, 3]
+
+
+def test_cli_plan_all_skips_an_object_without_a_grasp_and_exits_3_when_none_has_one(tmp_path, capsys):
+    huge = (60, 60, 360, 360, 0.05)  # 0.45 x 0.45 m: wider than any hand opens
+    args = _scene_files(tmp_path, huge, B)
+    assert main([*args, "--all", "--out", str(tmp_path / "plan.json")]) == 0
+    err = capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.glob("plan*.json")) == ["plan_2.json"]
+    assert "contourgrasp: object 1: no feasible grasp" in err
+    (tmp_path / "only").mkdir()
+    only = _scene_files(tmp_path / "only", huge)
+    assert main([*only, "--all", "--out", str(tmp_path / "only" / "plan.json")]) == 3
+    assert not list((tmp_path / "only").glob("plan*.json"))
+    assert "none of the 1 wholly visible objects was planned" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("boxes", "extra", "message"), [
+    ((C, (600, 0, 40, 40, 0.05)), ["--all"], "not completely visible: every region on the support surface"),
+    ((C, (600, 0, 40, 40, 0.05)), [], "not completely visible"),
+    ((), ["--all"], "nothing stands on the support surface"),
+    ((A,), ["--target", "100,400"], "no object at pixel (100, 400); the nearest candidate is at (300, 259)"),
+    ((A,), ["--target=-1,5"], "pixel (-1, 5) is outside the 640x480 image"),
+    ((A,), ["--roi", "0,0,50,50"], "no candidate in the ROI (0, 0, 50, 50): nothing stands on the support surface"),
+    ((A,), ["--all", "--segment", "rgb"], "--all plans every depth candidate"),
+    ((A,), ["--all", "--target", "1,1"], "not allowed with argument"),
+])
+def test_cli_plan_bad_targets_are_one_line_exit_2_nothing_written(tmp_path, capsys, boxes, extra, message):
+    args = _scene_files(tmp_path, *boxes)
+    code = main([*args, *extra, "--out", str(tmp_path / "plan.json")])
+    err = capsys.readouterr().err
+    assert code == 2 and not list(tmp_path.glob("plan*"))
+    assert message in err and len(err.strip().splitlines()) == 1
+
+
+def test_cli_plan_all_writes_all_or_nothing(tmp_path, capsys):
+    args = _scene_files(tmp_path, A, B, C)
+    (tmp_path / "plan_3.json").mkdir()  # the second object's plan cannot be written
+    assert main([*args, "--all", "--out", str(tmp_path / "plan.json")]) == 2
+    assert "plan_3.json: cannot write, it is a directory" in capsys.readouterr().err
+    assert not (tmp_path / "plan_2.json").exists()

@@ -30,3 +30,22 @@ def test_footprint_is_where_the_object_stands(tilt_deg):
     truth = render_footprint(kind="box", tilt_deg=tilt_deg, radius=0.03, centre=(0.03, 0.02))
     assert iou(seg.mask, truth) > 0.95
     assert iou(seen, truth) < 0.9
+
+
+@pytest.mark.parametrize("footprint", [False, True])
+def test_a_hole_that_sees_the_table_is_object_free_and_a_hole_of_missing_readings_is_filled(footprint):
+    import numpy as np
+
+    table = np.full((CAMERA.height, CAMERA.width), 0.7)
+    ring, block = table.copy(), table.copy()
+    ring[200:280, 280:360] = 0.68  # a 2 cm thick ring whose 40 x 40 px eye sees the table
+    ring[220:260, 300:340] = 0.7
+    block[200:280, 280:360] = 0.68  # a block with a hole of missing readings (fill_holes=False keeps it)
+    block[230:250, 310:330] = 0.0
+    eye = segment_depth(ring, CAMERA, fill_holes=False, footprint=footprint)
+    unseen = segment_depth(block, CAMERA, fill_holes=False, footprint=footprint)
+    assert not eye.mask[225:255, 305:335].any() and eye.mask[205:275, 285:292].all()
+    assert unseen.mask[230:250, 310:330].all()  # the unseen hole is object
+    assert eye.area_px == eye.mask.sum()
+    if not footprint:
+        assert eye.area_px == 6400 - 1600 and unseen.area_px == 6400

@@ -225,7 +225,8 @@ def test_continuous_plans_every_frame_without_a_call(ros, reference):
 
 
 @pytest.mark.parametrize("name, value", [("segment", "bogus"), ("hand", "no-such-hand"), ("standoff", -0.1),
-                                         ("pair_tolerance", 0.0), ("top_k", 0), ("standoff", 1)])
+                                         ("pair_tolerance", 0.0), ("top_k", 0), ("standoff", 1),
+                                         ("target", [1, 2, 3]), ("target", "centre")])
 def test_an_invalid_parameter_is_refused_at_start_naming_it(ros, name, value):
     context, _ = ros
     with pytest.raises(InputError, match=f"^parameter {name}: "):
@@ -291,5 +292,42 @@ def test_no_object_and_no_feasible_grasp_are_one_line_reasons(ros, tmp_path):
         camera.send(node, colour, image(flat, "32FC1", stamp_seconds(colour.header)))
         response = camera.call()
         assert not response.success and "no object found" in response.message and "\n" not in response.message
+    finally:
+        _stopped(ros, node, camera)
+
+
+def _set_target(camera, namespace, value):
+    """Set the node's ``target`` over DDS (its set_parameters service); the result."""
+    from rcl_interfaces.srv import SetParameters
+
+    client = camera.node.create_client(SetParameters, f"{namespace.rstrip('/')}/contourgrasp/set_parameters")
+    try:
+        assert client.wait_for_service(timeout_sec=TIMEOUT)
+        request = SetParameters.Request(parameters=[Parameter("target", value=value).to_parameter_msg()])
+        future = client.call_async(request)
+        assert spin_until(camera.executor, future.done, TIMEOUT), "no answer from set_parameters"
+        return future.result().results[0]
+    finally:
+        camera.node.destroy_client(client)
+
+
+def test_the_target_parameter_picks_the_object_and_may_be_set_while_running(ros, reference):
+    u, v = (int(x) for x in np.argwhere(reference.target.mask)[0][::-1])
+    node, camera = _started(ros, "/aim", target=[u, v])
+    try:
+        colour, depth, info = good_frame()
+        camera.send(node, colour, depth, info)
+        response = camera.call()
+        assert response.success
+        data = json.loads(response.message)
+        assert data["target"] == {"label": reference.target.label, "reason": f"the candidate under pixel ({u}, {v})"}
+        np.testing.assert_allclose(data["T_camera_hand"], reference.T_camera_hand, atol=1e-9)
+        assert _set_target(camera, "/aim", [320, 40]).successful
+        response = camera.call()
+        assert not response.success and response.message.startswith("no object at pixel (320, 40); the nearest")
+        refused = _set_target(camera, "/aim", [5])
+        assert not refused.successful and refused.reason.startswith("parameter target: must be a pixel [u, v]")
+        assert _set_target(camera, "/aim", [-1, -1]).successful
+        assert camera.call().success
     finally:
         _stopped(ros, node, camera)

@@ -126,15 +126,35 @@ def height_map_summary(heights) -> dict | None:
 def candidate_to_dict(candidate) -> dict:
     """The plan file's entry of a :class:`~contourgrasp.perception.Candidate` (not its mask or outline).
 
-    ``{label, area_px, height (m), centroid_px: [u, v], in_view, bbox: [x, y, w, h]}``.
+    ``{label, area_px, height (m), extent: [length, width] (m), centroid_px: [u, v], in_view, bbox: [x, y, w, h]}``.
     """
     return {
         "label": candidate.label,
         "area_px": candidate.area_px,
         "height": candidate.height,
+        "extent": [float(v) for v in candidate.extent],
         "centroid_px": [float(v) for v in candidate.centroid_px],
         "in_view": bool(candidate.in_view),
         "bbox": [int(v) for v in candidate.bbox],
+    }
+
+
+def support_to_dict(support) -> dict | None:
+    """The plan file's entry of a :class:`~contourgrasp.perception.Support`, None for None.
+
+    ``{normal: [x, y, z], offset (m: the camera's distance to the plane), tilt (rad), inliers (pixels),
+    planes_considered, reason}``, in the camera frame.
+    """
+    if support is None:
+        return None
+    plane = support.plane
+    return {
+        "normal": [float(v) for v in plane.normal],
+        "offset": float(plane.offset),
+        "tilt": plane.tilt,
+        "inliers": int(np.count_nonzero(plane.inliers)),
+        "planes_considered": len(support.planes),
+        "reason": support.reason,
     }
 
 
@@ -161,6 +181,7 @@ def image_plan_to_dict(result) -> dict:
         "R_camera_plane": metric.R_camera_plane.tolist(),
         "origin": metric.origin.tolist(),
     }
+    data["support_surface"] = support_to_dict(result.support)
     data["objects"] = [candidate_to_dict(c) for c in result.candidates]
     data["target"] = {"label": None if result.target is None else result.target.label, "reason": result.target_reason}
     data["approach_depth"] = metric.approach_depth

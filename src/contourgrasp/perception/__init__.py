@@ -12,6 +12,8 @@ One module per stage, in the order the pipeline runs them:
 * :mod:`~contourgrasp.perception.segment_depth` -- the region above the table, its footprint
 * :mod:`~contourgrasp.perception.candidates` -- every region standing on the table
   (:class:`Candidate`), the target to grasp among them
+* :mod:`~contourgrasp.perception.support` -- the support surface (a table or a bin's floor), the
+  candidates standing on it (:class:`Support`)
 * :mod:`~contourgrasp.perception.colour` -- colour-depth registration, flat parts found by colour
 * :mod:`~contourgrasp.perception.segmentation` -- :func:`segment` (the methods and the ``"auto"``
   rule), a user's mask
@@ -31,21 +33,22 @@ from __future__ import annotations
 
 from ..errors import PerceptionError, PerceptionWarning, SegmentationError
 from .camera import Intrinsics, as_depth, backproject, denoised_depth, fill_depth_holes, valid_depth
-from .candidates import TARGET_RULES, Candidate, choose_target, find_candidates
+from .candidates import TARGET_RULES, Candidate, choose_target, find_candidates, hand_opening
 from .colour import add_flat_parts, colour_offset, register_colour
 from .cross_section import cross_section
 from .height_map import HeightMap, height_map
 from .metric import DEPTH_MODES, DepthMode, MetricContour, approach_depth, contour_to_metric
 from .region import Segmentation, mask_contour
-from .segment_depth import object_footprint, segment_depth
+from .segment_depth import object_footprint, open_table_holes, segment_depth
 from .segment_rgb import segment_rgb
 from .segmentation import SEGMENT_METHODS, SegmentMethod, segment, segment_from_mask
+from .support import Support, find_support
 from .table import Plane, fit_plane, fit_table_plane
 
 __all__ = [
     "Candidate", "DEPTH_MODES", "DepthMode", "HeightMap", "Intrinsics", "MetricContour", "PerceptionError", "PerceptionWarning", "Plane",
-    "SEGMENT_METHODS", "SegmentMethod", "Segmentation", "SegmentationError", "TARGET_RULES", "add_flat_parts", "approach_depth",
+    "SEGMENT_METHODS", "SegmentMethod", "Segmentation", "SegmentationError", "Support", "TARGET_RULES", "add_flat_parts", "approach_depth",
     "as_depth", "backproject", "choose_target", "colour_offset", "contour_to_metric", "denoised_depth", "fill_depth_holes",
-    "cross_section", "find_candidates", "fit_plane", "fit_table_plane", "height_map", "mask_contour", "object_footprint", "register_colour", "segment",
+    "cross_section", "find_candidates", "find_support", "fit_plane", "fit_table_plane", "hand_opening", "height_map", "mask_contour", "object_footprint", "open_table_holes", "register_colour", "segment",
     "segment_depth", "segment_from_mask", "segment_rgb", "valid_depth",
 ]

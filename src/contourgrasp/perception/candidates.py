@@ -5,12 +5,20 @@ plane -- the same regions depth segmentation chooses from
 (:func:`~contourgrasp.perception.segment_depth.raised_pixels`), each with its
 outline, area, height and whether it is wholly in view.
 :func:`choose_target` picks one: the candidate under a pixel the user
-clicked, the one filling most of a region of interest, or by default the
-largest wholly visible one -- today's rule (section 4.1.3 of the thesis;
-:func:`~contourgrasp.perception.region.pick_object`), so that a frame with one
-object plans as before. Regions that touch the image border (a bin's wall, the
-robot's own fingers at the image's edge) are listed but never chosen: they
-are not a reason to refuse unless the chosen target touches it.
+clicked, the one filling most of a region of interest, or by default by the
+``"hand"`` rule: of the wholly visible candidates that fit the hand (the
+width of their minimum-area rectangle, in meters, at most the hand's opening),
+those at least ``SIMILAR_SIZE`` (half) as large as the largest of them are the
+contenders, and the one nearest the image centre wins. The size floor keeps a
+stray region from beating the object a user framed; the centre is where a
+user points the camera. When no candidate fits the hand, the largest wholly
+visible one is taken (the planner will say why it cannot grasp it). With one
+object in view this is today's rule, the largest wholly visible region
+(section 4.1.3 of the thesis; :func:`~contourgrasp.perception.region.pick_object`),
+so a frame with one object plans as before. Regions that touch the image
+border (a bin's wall, the robot's own fingers at the image's edge) are listed
+but never chosen: they are not a reason to refuse unless the chosen target
+touches it.
 """
 
 from __future__ import annotations
@@ -23,14 +31,14 @@ from scipy import ndimage
 
 from .. import validation
 from ..errors import PerceptionError, SegmentationError
-from ..tolerances import MIN_AREA_PX, MIN_HEIGHT, SENSOR_RANGE
+from ..tolerances import MIN_AREA_PX, MIN_HEIGHT, SENSOR_RANGE, SIMILAR_SIZE
 from .camera import Intrinsics, as_depth, check_intrinsics, valid_depth
 from .region import mask_contour, touching_regions
 from .segment_depth import raised_pixels
 from .table import Plane, heights
 
 #: The target rules of :func:`choose_target`.
-TARGET_RULES: tuple[str, ...] = ("largest", "centre")
+TARGET_RULES: tuple[str, ...] = ("hand", "largest", "centre")
 
 
 @dataclass(frozen=True, eq=False)
@@ -57,6 +65,10 @@ class Candidate:
     in_view : bool
         The region touches neither the image border nor the sensor's dead
         band (missing readings connected to the border): it is wholly seen.
+    extent : (float, float)
+        Length and width (length >= width) of the outline's minimum-area
+        rectangle, m, at the region's median depth (pixels x depth / fx):
+        the size a hand must span, to a few percent on a tilted camera.
     """
 
     label: int
@@ -67,6 +79,7 @@ class Candidate:
     centroid_px: tuple[float, float]
     bbox: tuple[int, int, int, int]
     in_view: bool
+    extent: tuple[float, float] = (0.0, 0.0)
 
 
 def find_candidates(
@@ -130,9 +143,19 @@ def find_candidates(
         box = np.s_[y:y + hh, x:x + w]  # a region's top and fill on its box only: speckle makes thousands of labels
         top = float(h[box][labels[box] == i].max())
         mask = _filled(labels == i, (x, y, w, hh))
-        found.append(Candidate(label, mask, mask_contour(mask), int(areas[i]), top,
-                               (float(centroids[i, 0]), float(centroids[i, 1])), (x, y, w, hh), not bool(touching[i])))
+        contour = mask_contour(mask)
+        found.append(Candidate(label, mask, contour, int(areas[i]), top,
+                               (float(centroids[i, 0]), float(centroids[i, 1])), (x, y, w, hh), not bool(touching[i]),
+                               _extent(contour, d[box][labels[box] == i], intrinsics)))
     return tuple(found)
+
+
+def _extent(contour_px, region_depth, intrinsics) -> tuple[float, float]:
+    """(length, width) in m of the outline's minimum-area rectangle, at the median valid depth of the region."""
+    sides = sorted(cv2.minAreaRect(contour_px.astype(np.float32))[1], reverse=True)
+    z = region_depth[np.isfinite(region_depth) & (region_depth > 0)]
+    scale = float(np.median(z)) / intrinsics.fx if len(z) else 0.0
+    return float(sides[0] * scale), float(sides[1] * scale)
 
 
 def _filled(region, bbox) -> np.ndarray:
@@ -144,7 +167,8 @@ def _filled(region, bbox) -> np.ndarray:
     return out
 
 
-def choose_target(candidates, *, target_px=None, roi=None, rule: str = "largest") -> tuple[Candidate, str]:
+def choose_target(candidates, *, target_px=None, roi=None, rule: str = "hand",
+                  max_width: float | None = None) -> tuple[Candidate, str]:
     """The candidate to grasp, and why it was chosen (one line).
 
     Parameters
@@ -156,12 +180,16 @@ def choose_target(candidates, *, target_px=None, roi=None, rule: str = "largest"
     roi : (int, int, int, int), optional
         A region of interest (x, y, w, h), pixels: the wholly visible
         candidate with most pixels inside it.
-    rule : {"largest", "centre"}
-        Without ``target_px`` and ``roi``: ``"largest"`` (the default) takes
-        the largest wholly visible candidate -- the rule of every segmentation
-        method (:func:`~contourgrasp.perception.region.pick_object`), so a
-        frame with one object plans as before; ``"centre"`` the wholly visible
-        candidate whose centroid lies nearest the image centre.
+    rule : {"hand", "largest", "centre"}
+        Without ``target_px`` and ``roi``: ``"hand"`` (the default) the rule
+        of the module docstring; ``"largest"`` the largest wholly visible
+        candidate -- the rule of every segmentation method
+        (:func:`~contourgrasp.perception.region.pick_object`); ``"centre"``
+        the wholly visible candidate whose centroid lies nearest the image
+        centre, whatever its size.
+    max_width : float, optional
+        The ``"hand"`` rule: the widest object the hand spans, m
+        (:func:`hand_opening`); None: every candidate fits.
 
     Returns
     -------
@@ -200,9 +228,32 @@ def choose_target(candidates, *, target_px=None, roi=None, rule: str = "largest"
         )
     if rule == "largest":
         return inner[0], f"the largest wholly visible candidate ({inner[0].area_px} px, of {len(candidates)})"
-    centre = np.array([(shape[1] - 1) / 2, (shape[0] - 1) / 2])
-    best = min(inner, key=lambda c: float(np.hypot(*(np.array(c.centroid_px) - centre))))
-    return best, f"the wholly visible candidate nearest the image centre (of {len(candidates)})"
+    if rule == "centre":
+        return _nearest_centre(inner), f"the wholly visible candidate nearest the image centre (of {len(candidates)})"
+    if max_width is not None:
+        max_width = validation.positive("max_width", max_width, error=PerceptionError)
+    fit = [c for c in inner if max_width is None or c.extent[1] <= max_width]
+    if not fit:
+        return inner[0], (f"the largest wholly visible candidate ({inner[0].area_px} px, of {len(candidates)}): "
+                          f"none is narrower than the hand's opening ({max_width * 1000:.0f} mm)")
+    contenders = [c for c in fit if c.area_px >= SIMILAR_SIZE * fit[0].area_px]
+    best = _nearest_centre(contenders)
+    return best, (f"of the {len(fit)} wholly visible candidate(s) that fit the hand (of {len(candidates)}), "
+                  f"the one nearest the image centre among the {len(contenders)} at least "
+                  f"{SIMILAR_SIZE:.0%} as large as the largest ({best.area_px} px)")
+
+
+def _nearest_centre(candidates):
+    """The candidate whose centroid lies nearest the image centre."""
+    height, width = candidates[0].mask.shape
+    centre = np.array([(width - 1) / 2, (height - 1) / 2])
+    return min(candidates, key=lambda c: float(np.hypot(*(np.array(c.centroid_px) - centre))))
+
+
+def hand_opening(hand) -> float:
+    """The widest object a hand spans, m: the largest distance between two of its fingers' start points."""
+    starts = np.asarray(hand.starts, dtype=float)
+    return float(np.max(np.linalg.norm(starts[:, None] - starts[None], axis=-1)))
 
 
 def check_pixel(target_px, shape=None) -> tuple[int, int]:

@@ -11,11 +11,13 @@ from dataclasses import replace
 
 import cv2
 import numpy as np
+from scipy import ndimage
 
 from .. import validation
 from ..errors import PerceptionError
-from ..tolerances import MAX_HOLE_PX, MIN_AREA_PX, MIN_HEIGHT, SENSOR_RANGE, TILT_PLANE_THRESHOLD
-from ._pixels import disc, in_image
+from ..tolerances import (MAX_HOLE_PX, MIN_AREA_PX, MIN_HEIGHT, MIN_TABLE_HOLE_PX, PLANE_THRESHOLD, SENSOR_RANGE,
+                          TILT_PLANE_THRESHOLD)
+from ._pixels import disc, grown_box, in_image
 from .camera import Intrinsics, as_depth, check_intrinsics, fill_depth_holes, valid_depth
 from .region import Segmentation, make_segmentation, pick_object
 from .table import Plane, fit_table_plane, footprint_pixels, heights
@@ -156,18 +158,54 @@ def raised_pixels(depth, intrinsics: Intrinsics, plane: Plane, *, min_height: fl
 
 
 def with_footprint(seg, depth, intrinsics, footprint, min_area_px) -> Segmentation:
-    """``seg`` moved onto the table (:func:`object_footprint`) when ``footprint``, or when None and the camera is tilted."""
+    """``seg`` moved onto the table (:func:`object_footprint`) when ``footprint``, or when None and the camera is
+    tilted; either way with the holes through which the table is seen opened again (:func:`open_table_holes`)."""
     if footprint is None:
         footprint = seg.plane.tilt > TILT_PLANE_THRESHOLD
     elif not isinstance(footprint, (bool, np.bool_)):
         raise PerceptionError(f"footprint must be True, False or None, got {footprint!r}")
     if not footprint:
-        return seg
+        return replace(seg, **_opened(seg.mask, depth, intrinsics, seg.plane))
     moved = object_footprint(seg.mask, depth, intrinsics, seg.plane)
     mask, notes = pick_object(moved, np.zeros_like(moved), min_area_px, "in the object's footprint on the table")
     result = make_segmentation(seg.method, mask, notes, plane=seg.plane, filled_px=seg.filled_px, on_table=True,
                            colour_offset_px=seg.colour_offset_px)
-    return replace(result, warnings=(*seg.warnings, *result.warnings))
+    return replace(result, warnings=(*seg.warnings, *result.warnings), **_opened(mask, depth, intrinsics, seg.plane))
+
+
+def _opened(mask, depth, intrinsics, plane) -> dict:
+    """The ``mask`` and ``area_px`` of a :class:`Segmentation` whose ``mask`` had its table holes opened."""
+    opened = open_table_holes(mask, depth, intrinsics, plane)
+    return {"mask": opened, "area_px": int(opened.sum())}
+
+
+def open_table_holes(mask, depth, intrinsics: Intrinsics, plane: Plane, *, min_px: int = MIN_TABLE_HOLE_PX) -> np.ndarray:
+    """(H, W) bool: ``mask`` less its holes through which the support surface is seen (a clamp's eye).
+
+    Every method fills the object's holes (:func:`~contourgrasp.perception.region.pick_object`): a
+    hole of missing readings or of the object's own shadow is object. A hole of at least ``min_px``
+    pixels more than half of whose pixels see the plane (within ``PLANE_THRESHOLD`` of it) shows
+    the table through the object and is object-free again. The outline is the outer one either
+    way (:attr:`Segmentation.contour_px`), so this changes the mask, not the plan's contour.
+    """
+    if not mask.any():
+        return mask
+    box = grown_box(mask, 1)  # holes lie inside the mask's box: the work is done there
+    m = mask[box]
+    with np.errstate(invalid="ignore"):
+        on_plane = m & valid_depth(depth[box]) & (np.abs(heights(depth, intrinsics, plane)[box]) < PLANE_THRESHOLD)
+    if not on_plane.any():
+        return mask
+    standing = m & ~on_plane
+    holes = ndimage.binary_fill_holes(standing) & ~standing
+    count, labels = cv2.connectedComponents(holes.astype(np.uint8), connectivity=4)
+    size = np.bincount(labels.ravel(), minlength=count)
+    seen = np.bincount(labels.ravel(), weights=on_plane.ravel(), minlength=count)
+    table = (size >= min_px) & (seen > 0.5 * size)
+    table[0] = False
+    out = mask.copy()
+    out[box] &= ~table[labels]
+    return out
 
 
 def object_footprint(mask, depth, intrinsics: Intrinsics, plane: Plane) -> np.ndarray:

@@ -7,7 +7,11 @@ within ``pair_tolerance`` seconds; a frame without a pair is not planned on.
 
 Serves ``~/plan`` (std_srvs/Trigger): plans on the newest pair and answers the
 plan JSON of ``contourgrasp plan``, or success false with the one-line reason.
-With ``continuous`` it plans every pair as it arrives. Each plan publishes
+With ``continuous`` it plans every pair as it arrives. Parameter ``target``
+([u, v], a pixel of the depth image; ``[-1, -1]`` for the default rule of
+:func:`contourgrasp.perception.choose_target`) names the object to plan on;
+unlike the others it may be set while the node runs (``ros2 param set
+/contourgrasp target "[320, 240]"``, e.g. from a click), and is checked when set. Each plan publishes
 ``~/grasp`` and ``~/pregrasp`` (geometry_msgs/PoseStamped: T_camera_hand and
 T_camera_pregrasp in the image's frame, at its stamp) and ``~/markers``
 (visualization_msgs/MarkerArray), and logs one line with its time.
@@ -19,11 +23,11 @@ import json
 import math
 import time
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import rclpy
 from geometry_msgs.msg import PoseStamped
-from rcl_interfaces.msg import ParameterDescriptor
+from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
 from rclpy.exceptions import InvalidParameterTypeException
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
@@ -61,7 +65,12 @@ PARAMETERS = {
     "yaw_step_deg": (0.0, "grid step in yaw, degrees; 0: the planner's"),
     "depth_mode": ("", "contour plane: max or plane; empty: the planner's"),
     "top_k": (10, "ranked distinct poses in the plan JSON"),
+    "target": ([-1, -1], "pixel [u, v] of the depth image: plan on the object under it; [-1, -1]: the default rule"),
 }
+
+#: Parameters that may be set while the node runs (checked by ``target_pixel`` when set).
+WRITABLE = ("target",)
+NO_TARGET = (-1, -1)
 
 
 @dataclass(frozen=True)
@@ -89,12 +98,24 @@ def settings_from_parameters(values: dict) -> Settings:
              "must be a positive time in s", v)
     _require(v["harmonics"] >= 0, "harmonics", "must be an integer >= 0 (0: the planner's)", v)
     _require(v["top_k"] >= 1, "top_k", "must be a positive integer", v)
+    target = target_pixel(v["target"])
     options = {"segment": v["segment"], "approach_offset": v["approach_offset"], "standoff": v["standoff"],
-               "top_k": v["top_k"]}
+               "top_k": v["top_k"]} | ({} if target is None else {"target_px": target})
     overrides = {"harmonics": v["harmonics"], "xy_step": v["xy_step"], "yaw_step": math.radians(v["yaw_step_deg"]),
                  "depth_mode": v["depth_mode"]}
     options |= {name: value for name, value in overrides.items() if value}
     return Settings(hand, planner, v["pair_tolerance"], v["continuous"], options)
+
+
+def target_pixel(value) -> tuple[int, int] | None:
+    """The ``target`` parameter's value as a pixel (u, v), or None for ``[-1, -1]``; :class:`InputError` names it."""
+    pixel = tuple(int(x) for x in value)
+    if pixel == NO_TARGET:
+        return None
+    if len(pixel) != 2 or min(pixel) < 0:
+        raise InputError(f"parameter target: must be a pixel [u, v] >= 0, or [-1, -1] for the default rule, "
+                         f"got {list(pixel)}")
+    return pixel
 
 
 def _loaded(name: str, load, value):
@@ -141,6 +162,7 @@ class ContourGraspNode(Node):
         self.pregrasp_publisher = self.create_publisher(PoseStamped, "~/pregrasp", 10)
         self.markers_publisher = self.create_publisher(MarkerArray, "~/markers", 10)
         self.create_service(Trigger, "~/plan", self._on_plan)
+        self.add_on_set_parameters_callback(self._on_set_parameters)
         self.get_logger().info(
             f"ready: hand {self.settings.hand.name}, planner {self.settings.planner.name}, "
             f"{'continuous' if self.settings.continuous else 'on ~/plan'}; colour, depth, camera_info from "
@@ -150,13 +172,27 @@ class ContourGraspNode(Node):
         values = {}
         for name, (default, description) in PARAMETERS.items():
             try:
-                parameter = self.declare_parameter(name, default, ParameterDescriptor(description=description,
-                                                                                      read_only=True))
+                parameter = self.declare_parameter(name, default, ParameterDescriptor(
+                    description=description, read_only=name not in WRITABLE))
             except InvalidParameterTypeException:
-                kind = {bool: "a bool", int: "an integer", float: "a double (write 1.0, not 1)", str: "a string"}
+                kind = {bool: "a bool", int: "an integer", float: "a double (write 1.0, not 1)", str: "a string",
+                        list: "an integer array [u, v]"}
                 raise InputError(f"parameter {name}: must be {kind[type(default)]}") from None
             values[name] = parameter.value
         return values
+
+    def _on_set_parameters(self, parameters):
+        """Check a new ``target`` (the only parameter not read-only) and take it for the next plans."""
+        options = dict(self.settings.options)
+        for parameter in (p for p in parameters if p.name in WRITABLE):
+            try:
+                pixel = target_pixel(parameter.value)
+            except InputError as err:  # ROS itself refuses a value that is not an integer array
+                return SetParametersResult(successful=False, reason=str(err))
+            options.pop("target_px", None)
+            options |= {} if pixel is None else {"target_px": pixel}
+        self.settings = replace(self.settings, options=options)
+        return SetParametersResult(successful=True)
 
     def _subscribe(self) -> None:
         self.create_subscription(Image, "color/image_raw", self._on_colour, NEWEST)
