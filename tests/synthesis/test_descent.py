@@ -1,6 +1,7 @@
 """The descent check against analytic truth (issue 16, item 1.3): a flat wall, a vertical cylinder, the lean rule."""
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -259,3 +260,17 @@ def test_descent_options_are_checked(hand):
         from contourgrasp import synthesis
         synthesis.search(np.array([[0, 0], [0.05, 0], [0.05, 0.05]]), load_hand("five-finger-curved-thumb"),
                          descent=Descent(heights, 0.05, 0.05))
+
+
+def test_a_pose_blocked_only_by_a_neighbour_says_so(hand):
+    """A 12 cm column ringed by a 15 cm wall 4 cm away: no pose fits, and the message names the neighbour."""
+    from contourgrasp import synthesis
+
+    r = 0.05
+    contour = np.c_[r * np.cos(np.linspace(0, 2 * np.pi, 200, endpoint=False)),
+                    r * np.sin(np.linspace(0, 2 * np.pi, 200, endpoint=False))]
+    ring = lambda x, y: (np.hypot(x, y) > r + 0.04) & (np.hypot(x, y) < r + 0.06)  # noqa: E731
+    heights = scene(lambda x, y: np.where(np.hypot(x, y) <= r, 0.05, np.where(ring(x, y), 0.15, 0.0)))
+    heights = replace(heights, object=heights.heights == 0.05, obstacles=heights.heights == 0.15)
+    with pytest.raises(NoFeasibleGrasp, match="blocked by a neighbouring object or the bin wall"):
+        synthesis.search(contour, hand, descent=Descent(heights, 0.02, 0.02), xy_step=0.01, yaw_step=math.radians(8))

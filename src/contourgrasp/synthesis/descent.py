@@ -73,7 +73,7 @@ in batches of poses. See the README for the measured time.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -110,6 +110,8 @@ class DescentCheck:
         The clearance asked for, m.
     tip_height : (p,) float
         The grasp height each pose was checked at, m.
+    poses : (p, 3) float
+        The poses checked.
     """
 
     feasible: np.ndarray
@@ -118,6 +120,7 @@ class DescentCheck:
     bodies: tuple[str, ...]
     margin: float
     tip_height: np.ndarray
+    poses: np.ndarray
 
     def reason(self, i: int) -> str:
         """Why pose ``i`` is refused (or that it is not), e.g. "the index distal strikes the map 3.0 mm deep"."""
@@ -258,7 +261,8 @@ def descent_feasible(hand: Hand, heights: HeightMap, poses, tip_height, *, margi
     feasible = clearance.min(axis=1) >= margin - _ROUNDING if len(clearance) else np.zeros(0, dtype=bool)
     tip = np.broadcast_to(np.asarray(tip_height, dtype=float), (len(clearance),)).copy()
     return DescentCheck(feasible=feasible, clearance=clearance, blocking=np.where(feasible, -1, worst),
-                        bodies=body_names(hand), margin=margin, tip_height=tip)
+                        bodies=body_names(hand), margin=margin, tip_height=tip,
+                        poses=np.asarray(poses, dtype=float).reshape(-1, 3))
 
 
 def descent_floor(hand: Hand, heights: HeightMap, poses) -> np.ndarray:
@@ -315,6 +319,17 @@ def check_candidates(hand: Hand, descent: Descent, poses, order, lam=None,
         if passed[rows].any():
             break
     return passed, tip, last
+
+
+def blocked_by_obstacles(hand: Hand, descent: Descent, check: DescentCheck) -> bool:
+    """Whether some pose ``check`` refused would descend clear but for the map's obstacle cells (neighbours, bin walls)."""
+    heights = descent.heights
+    if not heights.obstacles.any():
+        return False
+    bare = replace(heights, heights=np.where(heights.obstacles, 0.0, heights.heights),
+                   obstacles=np.zeros_like(heights.obstacles))
+    tip = np.full(len(check.poses), descent.max_tip_height)
+    return bool(descent_feasible(hand, bare, check.poses, tip, margin=descent.margin).feasible.any())
 
 
 def _links_first(hand, heights, poses, tip, lam, touching) -> np.ndarray:

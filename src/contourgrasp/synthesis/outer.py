@@ -34,7 +34,7 @@ from ..errors import HandError, NoFeasibleGrasp, PlannerError
 from ..hand import Hand, to_image
 from ._derived import hand_arrays
 from .cost import distance
-from .descent import Descent, DescentCheck, body_names, check_candidates, descent_feasible
+from .descent import Descent, DescentCheck, blocked_by_obstacles, body_names, check_candidates, descent_feasible
 from .evaluate import concatenate, evaluate_poses
 from .grid import SearchGrid, distinct_best, screen_grid
 from .inner import closest_approach
@@ -229,7 +229,7 @@ def _reevaluate_best(model, hand, screen: PoseEvaluation, n: int, curvature, d_m
         if result.feasible.any():
             return result
         if n >= len(order) or descended >= tol.MAX_DESCENT_POSES:
-            raise NoFeasibleGrasp(_diagnose_descent(last, descended, descent) if last is not None
+            raise NoFeasibleGrasp(_diagnose_descent(hand, last, descended, descent) if last is not None
                                   else _diagnose_exact(result, safeguards))
         n *= 4
 
@@ -246,11 +246,15 @@ def _by_cost(result: PoseEvaluation) -> np.ndarray:
     return feasible[np.argsort(result.cost[feasible], kind="stable")]
 
 
-def _diagnose_descent(check: DescentCheck, n: int, descent: Descent) -> str:
+def _diagnose_descent(hand: Hand, check: DescentCheck, n: int, descent: Descent) -> str:
     """Why every pose that reaches the object fails the descent check, with the best one's reason."""
     best = int(np.argmax(check.clearance.min(axis=1)))
     limit = (f"at a grasp height of {1000 * descent.tip_height:.0f} mm" if descent.max_tip_height == descent.tip_height
              else f"at any grasp height from {1000 * descent.tip_height:.0f} to {1000 * descent.max_tip_height:.0f} mm")
+    if blocked_by_obstacles(hand, descent, check):
+        return (f"blocked by a neighbouring object or the bin wall: every one of the {n} poses checked that reach "
+                f"the object would strike another raised region of the scene while the open hand descends {limit}; "
+                f"at the clearest, {check.reason(best)}")
     return (f"every one of the {n} poses checked that reach the object would strike the scene while the open "
             f"hand descends {limit}; at the clearest, {check.reason(best)}")
 
