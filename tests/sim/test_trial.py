@@ -79,3 +79,15 @@ def test_pose_must_face_the_table():
     flipped = np.diag([1.0, -1.0, -1.0, 1.0])
     with pytest.raises(InputError, match="camera's z"):
         execute_grasp(scene, flipped, 0.6)
+
+
+def test_a_planned_grasp_height_is_executed():
+    """The palm closes at the planned height plus the open tips' depth, not at the execution's own rule."""
+    from contourgrasp.sim.trial import execute_grasp, scripted_grasp
+    from contourgrasp.sim.scene import build_scene
+
+    for height in (0.03, 0.06):
+        scene = build_scene("can", seed=0)
+        transform, approach = scripted_grasp(scene, "good")
+        outcome = execute_grasp(scene, transform, approach, grasp_height=height)
+        assert scene.camera.height - outcome.palm_depth == pytest.approx(scene.hand.open_tip_depth + height)

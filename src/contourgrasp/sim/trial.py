@@ -5,11 +5,12 @@ Execution, given the hand pose ``T_camera_hand`` and the approach depth:
 1. the hand appears above the pose at a safe height, yaw aligned (the arm's
    transit is not simulated: nothing touches anything on the way), its
    fingertips :attr:`Execution.approach_height` above the object's top;
-2. it descends at :attr:`Execution.descend_speed` until the fingertips are just
-   above the table, but never brings the palm closer than
-   :attr:`Execution.palm_clearance` to ``approach_depth`` (so tall objects are
-   grasped lower down the fingers, not crushed by the palm) -- the part the
-   thesis's operator did by hand;
+2. it descends at :attr:`Execution.descend_speed` to the planner's grasp height
+   when the planner gave one (the open hand's lowest fingertip that high above
+   the table); otherwise until the fingertips are just above the table, but
+   never bringing the palm closer than :attr:`Execution.palm_clearance` to
+   ``approach_depth`` (so tall objects are grasped lower down the fingers, not
+   crushed by the palm) -- the part the thesis's operator did by hand;
 3. the tendon force ramps to its maximum over :attr:`Execution.close_time`,
    then squeezes for :attr:`Execution.squeeze_time`;
 4. the hand lifts :attr:`Execution.lift_height` and holds for
