@@ -293,3 +293,36 @@ def test_fuzz_the_command_line_never_tracebacks(fuzz_files):
 
     check()
     assert {p: Path(p).read_bytes() for p in files} == before  # no input was ever overwritten
+
+
+# --- hand-from-model (issue 19) ---
+
+@pytest.mark.parametrize("model", ["inspire", "jaco-three-finger"])
+def test_hand_from_model_writes_a_hand_that_plans(tmp_path, capsys, model):
+    hand = tmp_path / "hand.toml"
+    code, out, err = run(capsys, "hand-from-model", model, "--out", hand)
+    assert code == 0, err
+    assert "fit error mm" in out and f"hand -> {hand}" in out
+    code, out, err = run(capsys, "synth", "--contour", "example:can", "--hand", hand, *FAST, "--out",
+                         tmp_path / "plan.json")
+    assert code == 0, err
+    assert json.loads((tmp_path / "plan.json").read_text())["hand"] == model
+
+
+def test_hand_from_model_bad_input_is_one_line_and_writes_nothing(tmp_path, capsys):
+    model = Path(__file__).parent / "sim" / "fixtures" / "two-sliders.xml"
+    broken = tmp_path / "broken.xml"
+    broken.write_text("<mujoco><worldbody><body></mujoco>")
+    out = tmp_path / "hand.toml"
+    cases = [
+        ([model, "--fingertips", "left_tip", "thumb_tip"], "no site or body named 'thumb_tip'"),
+        ([model, "--fingertips", "left_tip", "right_tip", "--actuators", "right_drive"],
+         "fingertip 'left_tip' does not move"),
+        ([model, "--fingertips", "left_tip", "right_tip", "--palm", "plate"], "palm 'plate' is not a body (a geom)"),
+        ([broken, "--fingertips", "tip"], "broken.xml: cannot load the MuJoCo model"),
+        ([tmp_path / "missing.xml", "--fingertips", "tip"], "no such model file"),
+    ]
+    for argv, message in cases:
+        code, _, err = run(capsys, "hand-from-model", *argv, "--out", out)
+        assert code == 2 and message in err and len(err.strip().splitlines()) == 1, err
+        assert not out.exists()

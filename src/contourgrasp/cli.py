@@ -146,6 +146,7 @@ def _parser() -> argparse.ArgumentParser:
 
     _add_bench_parser(sub)
     _add_calibrate_parser(sub)
+    _add_hand_from_model_parser(sub)
     ros = sub.add_parser("ros", help="run the ROS 2 node contourgrasp (needs contourgrasp[ros])")
     ros.add_argument("--ros-args", nargs=argparse.REMAINDER, default=[], metavar="ARG",
                      help="ROS arguments: -p NAME:=VALUE, -r FROM:=TO, --params-file FILE, ...")
@@ -248,6 +249,19 @@ def _add_calibrate_parser(sub) -> None:
     calibrate.add_argument("--hand", default="five-finger-linear", help="preset name or hand TOML file (ray fingers)")
     calibrate.add_argument("--reference", help="finger given lambda_virt 0 (default: the one that closes last)")
     calibrate.add_argument("--out", help="write the hand TOML with the calibrated virtual starts here")
+
+
+def _add_hand_from_model_parser(sub) -> None:
+    derive = sub.add_parser("hand-from-model", help="derive a hand file by closing a MuJoCo hand model (MJCF)")
+    derive.add_argument("model", metavar="MODEL", help="MJCF file, or a bundled model: inspire, jaco-three-finger")
+    derive.add_argument("--fingertips", nargs="+", metavar="SITE|BODY",
+                        help="one site or body per finger (required for a file)")
+    derive.add_argument("--actuators", nargs="+", metavar="NAME",
+                        help="the synergy's actuators, driven together from the low to the high end of their "
+                             "ctrlrange (default: all on the palm; 'all')")
+    derive.add_argument("--palm", metavar="BODY", help="the palm body (default: the deepest body holding every "
+                                                       "fingertip)")
+    derive.add_argument("--out", required=True, help="the hand TOML to write")
 
 
 def _plan_options(args) -> dict:
@@ -442,6 +456,21 @@ def _calibrate(args) -> int:
     return EXIT_OK
 
 
+def _hand_from_model(args) -> int:
+    from .io.hand_file import hand_to_toml
+    from .sim.model_hand import derive_hand, fit_table
+
+    derivation = derive_hand(args.model, fingertips=args.fingertips, actuators=args.actuators, palm=args.palm)
+    print("\n".join(fit_table(derivation)))
+    comment = "\n".join([f"Derived by `contourgrasp hand-from-model` from {Path(args.model).name}: fit errors (mm)",
+                          *(f"  {fit.name}: {fit.kind} {1000 * fit.error:.2f}" for fit in derivation.fits),
+                          *derivation.notes])
+    with atomic_outputs(args.out, inputs=[*_inputs(args), args.model]) as (out,):
+        out.write_text(hand_to_toml(derivation.hand, comment=comment), encoding="utf-8")
+    print(f"hand -> {args.out}")
+    return EXIT_OK
+
+
 def _efd(args) -> int:
     contour = efd.clean_polygon(_contour(args.contour))
     for k in args.harmonics:
@@ -459,7 +488,7 @@ def _efd(args) -> int:
 
 
 COMMANDS = {"hands": _hands, "synth": _synth, "plan": _plan, "bench": _bench, "efd": _efd,
-            "calibrate": _calibrate, "ros": _ros}
+            "calibrate": _calibrate, "ros": _ros, "hand-from-model": _hand_from_model}
 
 
 def main(argv=None) -> int:

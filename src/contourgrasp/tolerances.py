@@ -313,3 +313,10 @@ MAX_PLAUSIBLE_DEPTH = 20.0
 
 #: A median depth below this (m) is closer than any depth camera measures.
 MIN_PLAUSIBLE_DEPTH = 0.02
+
+
+# --- hand models (sim.model_hand) ---
+
+#: Largest distance (m) of a MuJoCo model's fingertip path, projected on the palm plane, from the ray or
+#: elliptic arc fitted to it; a finger fitting neither within this is refused by hand-from-model.
+MODEL_FIT_TOLERANCE = 3e-3
