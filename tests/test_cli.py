@@ -132,7 +132,7 @@ def test_bad_option_values_exit_2(capsys):
     (["synth"], "contourgrasp synth: error: the following arguments are required: --contour "
                 "(see contourgrasp synth --help)"),
     (["nope"], "contourgrasp: error: argument command: invalid choice: 'nope' (choose from 'hands', 'synth', 'plan', "
-               "'bench', 'calibrate', 'ros', 'efd') (see contourgrasp --help)"),
+               "'bench', 'calibrate', 'hand-from-model', 'ros', 'efd') (see contourgrasp --help)"),
 ])
 def test_argument_errors_are_one_line_naming_help(capsys, argv, line):
     code, out, err = run(capsys, *argv)
@@ -326,3 +326,15 @@ def test_hand_from_model_bad_input_is_one_line_and_writes_nothing(tmp_path, caps
         code, _, err = run(capsys, "hand-from-model", *argv, "--out", out)
         assert code == 2 and message in err and len(err.strip().splitlines()) == 1, err
         assert not out.exists()
+
+
+def test_bench_on_a_hand_model_runs_and_refuses_mixed_options(tmp_path, capsys):
+    code, out, err = run(capsys, "bench", "--hand-model", "jaco-three-finger", "--objects", "can", "--trials", "1",
+                         "--planners", "default", "--workers", "1", "--out", tmp_path / "bench")
+    assert code == 0, err
+    assert "| default |" in out and (tmp_path / "bench" / "trials.json").exists()
+    for argv, message in [(["--hand-model", "inspire", "--hand", "three-finger"], "give --hand or --hand-model"),
+                          (["--fingertips", "tip"], "--fingertips needs --hand-model")]:
+        code, _, err = run(capsys, "bench", *argv, "--objects", "can", "--trials", "1", "--out", tmp_path / "other")
+        assert code == 2 and message in err and len(err.strip().splitlines()) == 1, err
+        assert not (tmp_path / "other").exists()

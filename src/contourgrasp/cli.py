@@ -227,7 +227,7 @@ def _add_bench_parser(sub) -> None:
     objects.add_argument("--mesh", nargs="+", metavar="FILE", help="OBJ/STL mesh files in meters, z up, instead")
     bench.add_argument("--trials", type=_positive_int, default=20, help="trials per object and planner")
     bench.add_argument("--seed", type=_non_negative_int, default=0, help="trial t uses seed SEED + t")
-    bench.add_argument("--hand", default="five-finger-linear", help="preset name or hand TOML file (ray fingers)")
+    bench.add_argument("--hand", help="preset name or hand TOML file (ray fingers) (default: five-finger-linear)")
     bench.add_argument("--planners", default="paper,default,centroid-principal-axis,random",
                        help="comma-separated planner names: presets, baselines, ablation steps or planner TOML files")
     bench.add_argument("--ablation", action="store_true",
@@ -242,6 +242,12 @@ def _add_bench_parser(sub) -> None:
                             "(pip install 'contourgrasp[cluster]')")
     bench.add_argument("--resume", metavar="DIR",
                        help="continue the bench whose outputs are in DIR (same settings), keeping its trials")
+    bench.add_argument("--hand-model", metavar="MODEL",
+                       help="simulate this MuJoCo hand model (MJCF file, or inspire, jaco-three-finger) and plan with "
+                            "the hand file derived from it (see hand-from-model), instead of --hand")
+    bench.add_argument("--fingertips", nargs="+", metavar="SITE|BODY", help="with --hand-model FILE: see hand-from-model")
+    bench.add_argument("--actuators", nargs="+", metavar="NAME", help="with --hand-model: see hand-from-model")
+    bench.add_argument("--palm", metavar="BODY", help="with --hand-model: see hand-from-model")
 
 
 def _add_calibrate_parser(sub) -> None:
@@ -424,8 +430,10 @@ def _bench(args) -> int:
         from .sim.planners import ablation_planners
 
         planners += [p.name for p in ablation_planners()[1:-1] if p.name not in planners]
+    mounted = _hand_model(args)
     setup = bench.Bench(objects=objects, planners=planners, trials=args.trials, seed=args.seed,
-                        hand=load_hand(args.hand), noise=args.noise, splits=splits)
+                        hand=load_hand(args.hand or "five-finger-linear") if mounted is None else mounted.hand, noise=args.noise, splits=splits,
+                        hand_model=mounted)
     journal, done = bench.resume(out, setup) if args.resume is not None else (None, ())
     with bench.executor(setup, workers=args.workers, ray=args.ray is not None, address=args.ray or None) as run:
         if journal is None:
@@ -438,6 +446,20 @@ def _bench(args) -> int:
     kept = f" ({len(done)} kept from {out / bench.JOURNAL})" if done else ""
     print(f"{len(results)} trials{kept} in {time.perf_counter() - started:.0f} s -> {', '.join(map(str, paths))}")
     return EXIT_OK
+
+
+def _hand_model(args):
+    """The bench's mounted hand model (``--hand-model``), or None for the hand built from ``--hand``."""
+    given = [f"--{name}" for name in ("fingertips", "actuators", "palm") if getattr(args, name) is not None]
+    if args.hand_model is None:
+        if given:
+            raise InputError(f"{given[0]} needs --hand-model")
+        return None
+    if args.hand is not None:
+        raise InputError("give --hand or --hand-model, not both (the model's hand file is derived from it)")
+    from .sim.model_mount import mount_model
+
+    return mount_model(args.hand_model, fingertips=args.fingertips, actuators=args.actuators, palm=args.palm)
 
 
 def _calibrate(args) -> int:

@@ -4,20 +4,24 @@ Reading of the model
 --------------------
 *Palm.* The palm body (default: the deepest body holding every fingertip) is fixed: every joint
 outside its subtree is held at its reference position (a free joint, an arm's joints), gravity is
-off (a hand on an arm is gravity-compensated; the bench's hand is).
+off (a hand on an arm is gravity-compensated; the bench's hand is) and so are contacts (free air:
+the fingers pass each other, as the bench's hand geoms do).
 
 *Synergy.* The named actuators (default: all whose joints lie on the palm's subtree) are driven
 together, the one-DoF power grasp of the thesis: at synergy ``u`` in [0, 1] every control is
-``low + u * (high - low)`` of its ``ctrlrange`` -- *open* is every actuator at the low end of its
-range, *closed* at the high end (a position servo's joint angles, a motor's or tendon's force). The
-hand settles open for :data:`SETTLE_TIME`, ``u`` ramps from 0 to 1 over ``close_time`` and holds
-for ``hold_time``; the fingertips after that hold are the closed hand.
+``open + u * (closed - open)``, the two ends of its ``ctrlrange`` (a position servo's joint angles,
+a motor's or tendon's force). The hand settles open for :data:`SETTLE_TIME`, ``u`` ramps from 0 to
+1 over ``close_time`` and holds for ``hold_time``. *Open* is the low end of every range unless the
+fingertips end farther apart (mean distance from their centroid) than they began: then the run is
+repeated from the high ends to the low ones. A finger is *closed* where its projected tip is
+farthest from where it was open: a curling finger's tip swings back under the palm at the end,
+which no ray or arc follows and an object in the way never sees. Actuators outside the synergy
+keep control 0, except those a :class:`ModelSpec` holds (a pre-shape).
 
 *Frames.* The 3-D hand frame is the palm body's frame with its axes renamed: z (the approach, toward
 the object) is the palm axis (+-x, +-y or +-z) best aligned with the mean direction from each
 finger's first hinge joint (the palm's origin for a finger without one) to its open fingertip -- the
-way the fingers point; x is the first of
-the palm's axes not along z, y = z x x. The origin is the palm body's origin moved along z to the
+way the fingers point; x is the first of the palm's axes not along z, y = z x x. The origin is the palm body's origin moved along z to the
 palm's underside: the largest z of the palm's own collision geoms (those of bodies welded to it),
 but no deeper than the shallowest finger's first joint (posts below the palm carry knuckles), so
 z = 0 is the plane of the palm's underside as in :mod:`contourgrasp.hand`; the palm plane is the
@@ -61,10 +65,10 @@ from .. import tolerances as tol  # noqa: E402
 from ..errors import HandError, HandFileError, SimulationError  # noqa: E402
 from ..hand import Arc, Finger, FingerChain, Hand, Palm, Ray, check_chain, polyline_distance  # noqa: E402
 from .calibrate import Closing, derive_virtual_starts  # noqa: E402
-from .scene import mujoco_warnings  # noqa: E402
+from .scene import TIMESTEP, mujoco_warnings  # noqa: E402
 
 #: Time the open hand settles before closing, s.
-SETTLE_TIME = 1.0
+SETTLE_TIME = 2.0
 #: Default gains of a derived hand (the five-finger-linear preset's).
 ALPHA, BETA, MISS_PENALTY = 25.0, 10000.0, 250.0
 
@@ -87,6 +91,9 @@ class ModelSpec:
     hold : tuple of (str, float)
         Actuators outside the synergy held at a fraction of their control range throughout (a
         pre-shape, such as a thumb's opposition); any other actuator keeps control 0.
+    approach : str or None
+        The palm axis (``"x"``, ``"-x"``, ..., ``"-z"``) that is the approach (the hand frame's z);
+        None: the axis the fingers point along (module docstring).
     """
 
     path: str
@@ -95,6 +102,7 @@ class ModelSpec:
     palm: str | None = None
     names: tuple[str, ...] | None = None
     hold: tuple[tuple[str, float], ...] = ()
+    approach: str | None = None
 
 
 def _bundled(folder: str, xml: str, fingers, **options) -> ModelSpec:
@@ -173,11 +181,50 @@ class Derivation:
     fits : tuple of FingerFit
     notes : tuple of str
         Why the hand has no 3-D chains, when it has none.
+    mount : Mount
+        How the simulation mounts and closes the model (:mod:`contourgrasp.sim.model_mount`).
     """
 
     hand: Hand
     fits: tuple[FingerFit, ...]
-    notes: tuple[str, ...] = ()
+    notes: tuple[str, ...]
+    mount: Mount
+
+
+@dataclass(frozen=True)
+class Mount:
+    """Where the model's palm sits in the 3-D hand frame and how its synergy was driven.
+
+    Attributes
+    ----------
+    palm : str
+        The palm body.
+    rotation : (3, 3) float
+        The palm body's axes in the hand frame (columns): ``v_hand = rotation @ v_palm + position``.
+    position : (3,) float
+        The palm body's origin in the hand frame, m.
+    actuators : tuple of str
+        The synergy's actuators.
+    open_controls, closed_controls : tuple of float
+        Their controls with the hand open and closed.
+    held : tuple of (str, float)
+        Actuators outside the synergy and the controls they hold.
+    finger_bodies : tuple of (str, int)
+        Each body of a finger (the palm's children toward a fingertip and all below them) and the
+        finger's index.
+    tip_depth : float
+        The fingertips' largest depth below the palm's underside while closing, m.
+    """
+
+    palm: str
+    rotation: tuple[tuple[float, float, float], ...]
+    position: tuple[float, float, float]
+    actuators: tuple[str, ...]
+    open_controls: tuple[float, ...]
+    closed_controls: tuple[float, ...]
+    held: tuple[tuple[str, float], ...]
+    finger_bodies: tuple[tuple[str, int], ...]
+    tip_depth: float
 
 
 @dataclass(frozen=True, eq=False)
@@ -196,6 +243,7 @@ class ClosedModel:
     radius : (n,) float
     palm : Palm or None
         The palm geoms' rectangle on the palm plane and their thickness; None without palm geoms.
+    mount : Mount
     """
 
     names: tuple[str, ...]
@@ -204,6 +252,7 @@ class ClosedModel:
     joints: tuple[np.ndarray, ...]
     radius: np.ndarray
     palm: Palm | None
+    mount: Mount
 
 
 def load_model(path) -> mujoco.MjModel:
@@ -262,7 +311,7 @@ def derive_hand(model, *, fingertips=None, actuators=None, palm=None, name: str 
                 miss_penalty=MISS_PENALTY, description=f"derived from {Path(spec.path).name} by hand-from-model")
     hand = _with_virtual_starts(hand, closed)
     hand, notes = _with_chains(hand, closed, ends)
-    return Derivation(hand=hand, fits=tuple(fits), notes=notes)
+    return Derivation(hand=hand, fits=tuple(fits), notes=notes, mount=closed.mount)
 
 
 def _min_touching(n: int) -> int:
@@ -274,6 +323,9 @@ def close_model(spec: ModelSpec, *, close_time: float = 1.0, hold_time: float = 
     source = spec.path
     m = load_model(source)
     m.opt.gravity[:] = 0.0
+    m.opt.timestep, m.opt.integrator = TIMESTEP, mujoco.mjtIntegrator.mjINT_IMPLICITFAST  # the scene's
+    collides = (m.geom_contype != 0) | (m.geom_conaffinity != 0)
+    m.geom_contype[:] = m.geom_conaffinity[:] = 0  # free air: nothing to touch, fingers pass each other (as in the scene)
     palm = _palm_body(m, spec, source)
     subtree = _subtree(m, palm)
     tips = [_fingertip(m, name, subtree, source) for name in spec.fingertips]
@@ -285,7 +337,8 @@ def close_model(spec: ModelSpec, *, close_time: float = 1.0, hold_time: float = 
     lo, hi = m.actuator_ctrlrange[acts, 0], m.actuator_ctrlrange[acts, 1]
     tips_palm, joint_records, d = run(acts, lo, hi, held, source)
     if _spread(tips_palm[:, -1]) > _spread(tips_palm[:, 0]):  # the high ends open the hand: close toward the low
-        tips_palm, joint_records, d = run(acts, hi, lo, held, source)
+        lo, hi = hi, lo
+        tips_palm, joint_records, d = run(acts, lo, hi, held, source)
     moved = np.linalg.norm(tips_palm - tips_palm[:, :1], axis=2).max(axis=1)
     if (still := np.flatnonzero(moved < tol.FINGER_MOVED)).size:
         i = int(still[0])
@@ -293,16 +346,36 @@ def close_model(spec: ModelSpec, *, close_time: float = 1.0, hold_time: float = 
                         f"({', '.join(m.actuator(a).name for a in acts)}) close (it moves "
                         f"{1000 * moved[i]:.2f} mm, at least {1000 * tol.FINGER_MOVED:g} mm)")
     roots = np.array([joint_records[i][0, 0] if len(c) else np.zeros(3) for i, c in enumerate(chains)])
-    axes = _hand_axes(tips_palm[:, 0] - roots)
-    palm_geoms = _palm_geoms(m, d, palm, subtree, axes)
+    axes = _hand_axes(tips_palm[:, 0] - roots if spec.approach is None else _axis(spec.approach, source)[None])
+    palm_geoms = _palm_geoms(m, d, palm, subtree, axes, collides)
     knuckles = [float(joint_records[i][0, 0] @ axes[2]) for i, c in enumerate(chains) if len(c)]
     depth = 0.0 if palm_geoms is None else min([float(palm_geoms[:, 2].max())] + knuckles)
     shift = np.array([0.0, 0.0, depth])
+    tips_hand = tips_palm @ axes.T - shift
+    mount = Mount(palm=m.body(palm).name, rotation=tuple(map(tuple, axes.tolist())), position=tuple(-shift),
+                  actuators=tuple(m.actuator(a).name for a in acts), open_controls=tuple(lo.tolist()),
+                  closed_controls=tuple(hi.tolist()), held=tuple((m.actuator(a).name, v) for a, v in held),
+                  finger_bodies=_finger_bodies(m, palm, tips), tip_depth=float(tips_hand[:, :, 2].max()))
     return ClosedModel(names=tuple(spec.names or spec.fingertips), times=m.opt.timestep * np.arange(tips_palm.shape[1]),
-                       tips=tips_palm @ axes.T - shift,
+                       tips=tips_hand, mount=mount,
                        joints=tuple(np.transpose(j, (1, 0, 2)) @ axes.T - shift for j in joint_records),
-                       radius=np.array([_tip_radius(m, t) for t in tips]),
+                       radius=np.array([_tip_radius(m, t, collides) for t in tips]),
                        palm=None if palm_geoms is None else _palm_plate(palm_geoms - shift))
+
+
+def _finger_bodies(m, palm: int, tips) -> tuple[tuple[str, int], ...]:
+    """Each body below the palm that lies on a finger (toward its tip, or below such a body), with the finger."""
+    owner = {}
+    for i, tip in enumerate(tips):
+        body = _tip_body(m, tip)
+        while body != palm:
+            owner.setdefault(body, i)
+            body = int(m.body_parentid[body])
+    for b in range(palm + 1, m.nbody):  # depth first: a parent before its children
+        parent = int(m.body_parentid[b])
+        if b not in owner and parent in owner:
+            owner[b] = owner[parent]
+    return tuple((m.body(b).name, i) for b, i in sorted(owner.items()))
 
 
 def _spread(points: np.ndarray) -> float:
@@ -336,7 +409,7 @@ class _Run:
                 mujoco.mj_step(m, d) if k else mujoco.mj_forward(m, d)
                 if k >= settle:
                     position, rotation = d.xpos[self.palm].copy(), d.xmat[self.palm].reshape(3, 3).copy()
-                    records.append([(_point(m, d, t) - position) @ rotation for t in self.tips])
+                    records.append([(_point(d, t) - position) @ rotation for t in self.tips])
                     joint_records.append([(d.xanchor[c] - position) @ rotation for c in self.chains])
         if d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number > 0 or not np.isfinite(np.asarray(records)).all():
             raise SimulationError(f"{source}: the model is unstable while closing (NaN or huge accelerations)")
@@ -407,7 +480,7 @@ def _fingertip(m, name: str, subtree: set[int], source: str) -> tuple[str, int]:
     return ("site", site) if site >= 0 else ("body", body)
 
 
-def _point(m, d, tip: tuple[str, int]) -> np.ndarray:
+def _point(d, tip: tuple[str, int]) -> np.ndarray:
     kind, index = tip
     return d.site_xpos[index].copy() if kind == "site" else d.xpos[index].copy()
 
@@ -465,6 +538,14 @@ def _moving_path(m, tip: tuple[str, int], palm: int) -> list[int]:
     return joints
 
 
+def _axis(name: str, source: str) -> np.ndarray:
+    """The palm axis called ``name`` ("x", "-y", ...) as a unit 3-vector."""
+    axes = {f"{sign}{a}": (-1.0 if sign else 1.0) * np.eye(3)[i] for i, a in enumerate("xyz") for sign in ("", "-")}
+    if name not in axes:
+        raise HandFileError(f"{source}: approach must be one of {', '.join(axes)}, got {name!r}")
+    return axes[name]
+
+
 def _hand_axes(pointing: np.ndarray) -> np.ndarray:
     """(3, 3) rows x, y, z of the hand frame in palm coordinates: z the signed palm axis nearest ``pointing``."""
     mean = pointing.mean(axis=0)
@@ -475,27 +556,26 @@ def _hand_axes(pointing: np.ndarray) -> np.ndarray:
     return np.stack([x, np.cross(z, x), z])
 
 
+#: The eight corners of a unit box, for the geoms' local bounding boxes.
+_CORNERS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)
+
+
+def _local_corners(m, g: int) -> np.ndarray:
+    """(8, 3) float: the corners of geom ``g``'s bounding box in its own frame."""
+    return m.geom_aabb[g, :3] + _CORNERS * m.geom_aabb[g, 3:]
+
+
 def _geom_corners(m, d, geoms, origin: np.ndarray, rotation: np.ndarray) -> np.ndarray:
     """(8 g, 3) float: the corners of each geom's local bounding box, in the frame (origin, rotation)."""
-    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)
-    corners = []
-    for g in geoms:
-        centre, half = m.geom_aabb[g, :3], m.geom_aabb[g, 3:]
-        local = centre + signs * half
-        world = local @ d.geom_xmat[g].reshape(3, 3).T + d.geom_xpos[g]
-        corners.append((world - origin) @ rotation)
-    return np.concatenate(corners)
+    return np.concatenate([(_local_corners(m, g) @ d.geom_xmat[g].reshape(3, 3).T + d.geom_xpos[g] - origin) @ rotation
+                           for g in geoms])
 
 
-def _collides(m, g: int) -> bool:
-    return bool(m.geom_contype[g] or m.geom_conaffinity[g])
-
-
-def _palm_geoms(m, d, palm: int, subtree: set[int], axes: np.ndarray) -> np.ndarray | None:
+def _palm_geoms(m, d, palm: int, subtree: set[int], axes: np.ndarray, collides: np.ndarray) -> np.ndarray | None:
     """Corners of the palm's own collision geoms (bodies welded to it), hand axes, palm origin; None if none."""
     weld = int(m.body_weldid[palm])
     geoms = [g for g in range(m.ngeom) if int(m.geom_bodyid[g]) in subtree
-             and int(m.body_weldid[m.geom_bodyid[g]]) == weld and _collides(m, g)]
+             and int(m.body_weldid[m.geom_bodyid[g]]) == weld and collides[g]]
     if not geoms:
         return None
     rotation = d.xmat[palm].reshape(3, 3)
@@ -507,18 +587,17 @@ def _palm_plate(corners: np.ndarray) -> Palm:
     return Palm(outline=((x0, y0), (x1, y0), (x1, y1), (x0, y1)), thickness=max(float(-z0), tol.FINGER_MOVED))
 
 
-def _tip_radius(m, tip: tuple[str, int]) -> float:
+def _tip_radius(m, tip: tuple[str, int], collides: np.ndarray) -> float:
     """Half the smallest extent of the fingertip body's collision geoms, in that body's frame; 0 without any."""
     body = _tip_body(m, tip)
-    geoms = [g for g in range(m.ngeom) if int(m.geom_bodyid[g]) == body and _collides(m, g)]
+    geoms = [g for g in range(m.ngeom) if int(m.geom_bodyid[g]) == body and collides[g]]
     if not geoms:
         return 0.0
-    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)
     corners = []
     for g in geoms:
         rotation = np.empty(9)
         mujoco.mju_quat2Mat(rotation, m.geom_quat[g])
-        corners.append((m.geom_aabb[g, :3] + signs * m.geom_aabb[g, 3:]) @ rotation.reshape(3, 3).T + m.geom_pos[g])
+        corners.append(_local_corners(m, g) @ rotation.reshape(3, 3).T + m.geom_pos[g])
     points = np.concatenate(corners)
     return float(np.ptp(points, axis=0).min() / 2)
 
