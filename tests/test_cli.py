@@ -245,7 +245,7 @@ def _value(option):
 
 @st.composite
 def argv_strategy(draw, files, folder):
-    command = draw(st.sampled_from(["synth", "synth", "efd", "plan", "hands", "bench", "calibrate"]))
+    command = draw(st.sampled_from(["synth", "synth", "efd", "plan", "hands", "bench", "calibrate", "hand-from-model"]))
     any_file = st.sampled_from(files + ["example:can", "example:nope", str(folder / "missing.csv")])
     argv = [command]
     if command in ("synth", "efd"):
@@ -257,6 +257,8 @@ def argv_strategy(draw, files, folder):
         argv += ["--mesh", draw(any_file), "--planners", draw(st.sampled_from(["nope", ""])), "--trials", "1"]
     if command == "calibrate":  # never simulates: every hand here is malformed or refused
         argv += ["--hand", draw(any_file | st.just("five-finger-curved-thumb"))]
+    if command == "hand-from-model":  # never simulates: every model here is malformed or missing
+        argv += [draw(any_file), "--fingertips", "tip", *draw(st.sampled_from([[], ["--palm", "palm"]]))]
     if command in ("synth", "plan"):
         argv += ["--yaw-step-deg", draw(_value("--yaw-step-deg"))]  # bounds the grid unless the value is refused
         for option in draw(st.lists(st.sampled_from(sorted(FAST_VALUES) + SWITCHES + FILE_OPTIONS), max_size=6)):
@@ -268,11 +270,11 @@ def argv_strategy(draw, files, folder):
                 argv += [option, draw(_value(option) | any_file if option in FILE_OPTIONS else _value(option))]
     if command == "efd":
         argv += ["--harmonics", *draw(st.lists(_value("--harmonics"), min_size=1, max_size=3))]
-    if command in ("synth", "plan", "efd", "calibrate") and draw(st.booleans()):
+    if command in ("synth", "plan", "efd", "calibrate") and draw(st.booleans()) or command == "hand-from-model":
         own_inputs = [a for a in argv if a in files]  # an output naming an input must be refused
         targets = st.sampled_from([str(folder / "out.json"), str(folder / "adir"), str(folder / "no" / "x.json"),
                                    *own_inputs])
-        argv += [draw(st.sampled_from(["--out", "--plot"])), draw(targets)]
+        argv += [draw(st.sampled_from(["--out"] if command == "hand-from-model" else ["--out", "--plot"])), draw(targets)]
     return argv
 
 

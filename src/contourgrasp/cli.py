@@ -25,6 +25,8 @@ from .io.planner_file import load_planner, planner_names, synthesis_options
 from .io.plan_file import atomic_outputs, plan_to_dict, write_json
 
 EXIT_OK, EXIT_INPUT, EXIT_INFEASIBLE = 0, 2, 3
+#: The palm axes hand-from-model and bench --hand-model accept as the approach.
+APPROACHES = ("x", "-x", "y", "-y", "z", "-z")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -248,6 +250,7 @@ def _add_bench_parser(sub) -> None:
     bench.add_argument("--fingertips", nargs="+", metavar="SITE|BODY", help="with --hand-model FILE: see hand-from-model")
     bench.add_argument("--actuators", nargs="+", metavar="NAME", help="with --hand-model: see hand-from-model")
     bench.add_argument("--palm", metavar="BODY", help="with --hand-model: see hand-from-model")
+    bench.add_argument("--approach", choices=APPROACHES, help="with --hand-model: see hand-from-model")
 
 
 def _add_calibrate_parser(sub) -> None:
@@ -267,6 +270,8 @@ def _add_hand_from_model_parser(sub) -> None:
                              "ctrlrange (default: all on the palm; 'all')")
     derive.add_argument("--palm", metavar="BODY", help="the palm body (default: the deepest body holding every "
                                                        "fingertip)")
+    derive.add_argument("--approach", choices=APPROACHES,
+                        help="the palm body's axis toward the object (default: the axis the fingers point along)")
     derive.add_argument("--out", required=True, help="the hand TOML to write")
 
 
@@ -431,9 +436,9 @@ def _bench(args) -> int:
 
         planners += [p.name for p in ablation_planners()[1:-1] if p.name not in planners]
     mounted = _hand_model(args)
-    setup = bench.Bench(objects=objects, planners=planners, trials=args.trials, seed=args.seed,
-                        hand=load_hand(args.hand or "five-finger-linear") if mounted is None else mounted.hand, noise=args.noise, splits=splits,
-                        hand_model=mounted)
+    hand = load_hand(args.hand or "five-finger-linear") if mounted is None else mounted.hand
+    setup = bench.Bench(objects=objects, planners=planners, trials=args.trials, seed=args.seed, hand=hand,
+                        noise=args.noise, splits=splits, hand_model=mounted)
     journal, done = bench.resume(out, setup) if args.resume is not None else (None, ())
     with bench.executor(setup, workers=args.workers, ray=args.ray is not None, address=args.ray or None) as run:
         if journal is None:
@@ -450,7 +455,7 @@ def _bench(args) -> int:
 
 def _hand_model(args):
     """The bench's mounted hand model (``--hand-model``), or None for the hand built from ``--hand``."""
-    given = [f"--{name}" for name in ("fingertips", "actuators", "palm") if getattr(args, name) is not None]
+    given = [f"--{name}" for name in ("fingertips", "actuators", "palm", "approach") if getattr(args, name) is not None]
     if args.hand_model is None:
         if given:
             raise InputError(f"{given[0]} needs --hand-model")
@@ -459,7 +464,8 @@ def _hand_model(args):
         raise InputError("give --hand or --hand-model, not both (the model's hand file is derived from it)")
     from .sim.model_mount import mount_model
 
-    return mount_model(args.hand_model, fingertips=args.fingertips, actuators=args.actuators, palm=args.palm)
+    return mount_model(args.hand_model, fingertips=args.fingertips, actuators=args.actuators, palm=args.palm,
+                       approach=args.approach)
 
 
 def _calibrate(args) -> int:
@@ -482,7 +488,8 @@ def _hand_from_model(args) -> int:
     from .io.hand_file import hand_to_toml
     from .sim.model_hand import derive_hand, fit_table
 
-    derivation = derive_hand(args.model, fingertips=args.fingertips, actuators=args.actuators, palm=args.palm)
+    derivation = derive_hand(args.model, fingertips=args.fingertips, actuators=args.actuators, palm=args.palm,
+                             approach=args.approach)
     print("\n".join(fit_table(derivation)))
     comment = "\n".join([f"Derived by `contourgrasp hand-from-model` from {Path(args.model).name}: fit errors (mm)",
                           *(f"  {fit.name}: {fit.kind} {1000 * fit.error:.2f}" for fit in derivation.fits),

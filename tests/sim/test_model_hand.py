@@ -65,6 +65,16 @@ def test_own_simulated_hand_reproduces_the_preset_within_a_millimetre(tmp_path):
     assert parse_hand(hand_to_toml(derived.hand)) == derived.hand
 
 
+def test_the_approach_axis_decides_the_palm_plane(sliders):
+    # approaching along the palm's x, the left finger slides along the approach: it does not close
+    with pytest.raises(HandError, match="finger 'left_tip': its tip moves 0.00 mm on the palm plane"):
+        derive_hand(sliders, fingertips=["left_tip", "right_tip"], approach="x")
+    flipped = derive_hand(sliders, fingertips=["left_tip", "right_tip"], approach="-z").hand.fingers[0]
+    np.testing.assert_allclose(flipped.start, [-0.05, -0.01], atol=1e-6)  # x kept, y = z x x turned over
+    with pytest.raises(HandFileError, match="approach must be one of x, -x"):
+        derive_hand(sliders, fingertips=["left_tip", "right_tip"], approach="up")
+
+
 def test_fit_finger_recovers_an_arc_and_refuses_a_zigzag():
     truth = Arc(0.05, 0.03, 3.5)
     lam = np.linspace(0.0, 0.06, 300)

@@ -19,13 +19,14 @@ which no ray or arc follows and an object in the way never sees. Actuators outsi
 keep control 0, except those a :class:`ModelSpec` holds (a pre-shape).
 
 *Frames.* The 3-D hand frame is the palm body's frame with its axes renamed: z (the approach, toward
-the object) is the palm axis (+-x, +-y or +-z) best aligned with the mean direction from each
-finger's first hinge joint (the palm's origin for a finger without one) to its open fingertip -- the
-way the fingers point; x is the first of the palm's axes not along z, y = z x x. The origin is the palm body's origin moved along z to the
-palm's underside: the largest z of the palm's own collision geoms (those of bodies welded to it),
-but no deeper than the shallowest finger's first joint (posts below the palm carry knuckles), so
-z = 0 is the plane of the palm's underside as in :mod:`contourgrasp.hand`; the palm plane is the
-plane z = 0, and the fingertips' paths are projected on it along z.
+the object) is the :class:`ModelSpec`'s ``approach`` axis, or else the palm axis (+-x, +-y or +-z)
+best aligned with the mean direction from each finger's first hinge joint (the palm's origin for a
+finger without one) to its open fingertip -- the way the fingers point; x is the first of the palm's
+axes not along z, y = z x x. The origin is the palm body's origin moved along z to the palm's
+underside: the largest z of the palm's own collision geoms (those of bodies welded to it), but no
+deeper than the shallowest finger's first joint (posts below the palm carry knuckles), so z = 0 is
+the plane of the palm's underside as in :mod:`contourgrasp.hand`; the palm plane is the plane z = 0,
+and the fingertips' paths are projected on it along z.
 
 *Trajectories.* Each fingertip's path, projected on the palm plane, is fitted by a ray (eq 3.18:
 start the open tip, direction and travel to the closed tip) and, when the ray leaves the path by more
@@ -126,13 +127,13 @@ MODELS = {
 }
 
 
-def model_spec(model, *, fingertips=None, actuators=None, palm=None) -> ModelSpec:
+def model_spec(model, *, fingertips=None, actuators=None, palm=None, approach=None) -> ModelSpec:
     """A :class:`ModelSpec` from a bundled model's name (:data:`MODELS`) or an MJCF path; options override.
 
     Raises
     ------
     HandFileError
-        A path without fingertips, or fingertips of a bundled model not matching its finger count.
+        A path without fingertips.
     """
     if isinstance(model, ModelSpec):
         spec = model
@@ -147,6 +148,8 @@ def model_spec(model, *, fingertips=None, actuators=None, palm=None) -> ModelSpe
         spec = replace(spec, fingertips=tuple(fingertips), names=None)
     if actuators is not None:
         spec = replace(spec, actuators=tuple(actuators))
+    if approach is not None:
+        spec = replace(spec, approach=approach)
     return replace(spec, palm=palm) if palm is not None else spec
 
 
@@ -268,7 +271,7 @@ def load_model(path) -> mujoco.MjModel:
         raise HandFileError(f"{path}: cannot load the MuJoCo model ({reason})") from None
 
 
-def derive_hand(model, *, fingertips=None, actuators=None, palm=None, name: str | None = None,
+def derive_hand(model, *, fingertips=None, actuators=None, palm=None, approach=None, name: str | None = None,
                 close_time: float = 1.0, hold_time: float = 0.5) -> Derivation:
     """Close a MuJoCo hand model with one synergy and fit its hand file (module docstring).
 
@@ -276,8 +279,8 @@ def derive_hand(model, *, fingertips=None, actuators=None, palm=None, name: str 
     ----------
     model : str, Path or ModelSpec
         A bundled model's name (:data:`MODELS`) or an MJCF file.
-    fingertips, actuators, palm
-        Override the :class:`ModelSpec`'s (required for a file).
+    fingertips, actuators, palm, approach
+        Override the :class:`ModelSpec`'s (fingertips are required for a file).
     name : str, optional
         The hand's name; default the model file's stem.
     close_time, hold_time : float
@@ -297,7 +300,7 @@ def derive_hand(model, *, fingertips=None, actuators=None, palm=None, name: str 
     SimulationError
         The model is unstable while closing.
     """
-    spec = model_spec(model, fingertips=fingertips, actuators=actuators, palm=palm)
+    spec = model_spec(model, fingertips=fingertips, actuators=actuators, palm=palm, approach=approach)
     closed = close_model(spec, close_time=close_time, hold_time=hold_time)
     fingers, fits, ends = [], [], []
     for i, finger_name in enumerate(closed.names):

@@ -133,14 +133,15 @@ def _named_geoms(path: str):
     return child
 
 
-def mount_model(model, *, fingertips=None, actuators=None, palm=None, design: HandDesign = HandDesign()) -> MountedHand:
+def mount_model(model, *, fingertips=None, actuators=None, palm=None, approach=None,
+                design: HandDesign = HandDesign()) -> MountedHand:
     """Derive a hand model's hand file and mount it for the simulation.
 
     Parameters
     ----------
     model : str or Path
         A bundled model's name (:data:`~contourgrasp.sim.model_hand.MODELS`) or an MJCF file.
-    fingertips, actuators, palm
+    fingertips, actuators, palm, approach
         As :func:`~contourgrasp.sim.model_hand.derive_hand`.
     design : HandDesign
         The base servos' gains.
@@ -150,5 +151,5 @@ def mount_model(model, *, fingertips=None, actuators=None, palm=None, design: Ha
     HandFileError, HandError, SimulationError
         As :func:`~contourgrasp.sim.model_hand.derive_hand`.
     """
-    derivation = derive_hand(model, fingertips=fingertips, actuators=actuators, palm=palm)
+    derivation = derive_hand(model, fingertips=fingertips, actuators=actuators, palm=palm, approach=approach)
     return MountedHand(path=model_spec(model, fingertips=fingertips).path, derivation=derivation, design=design)
