@@ -164,7 +164,8 @@ class Scene:
             mujoco.mj_forward(self.model, self.data)
 
     def command(self, base_target, closing: float) -> None:
-        """Servo targets for the hand base (x, y, z, yaw) and the tendon force fraction."""
+        """Servo targets for the hand base (x, y, z, yaw) and the closing (the tendon force fraction, or a mounted
+        hand model's synergy: 0 open, 1 closed)."""
         self.data.ctrl[self._base_ctrl] = base_target
         actuators, open_, closed = self._closing
         self.data.ctrl[actuators] = open_ + closing * (closed - open_)
