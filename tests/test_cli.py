@@ -132,7 +132,7 @@ def test_bad_option_values_exit_2(capsys):
     (["synth"], "contourgrasp synth: error: the following arguments are required: --contour "
                 "(see contourgrasp synth --help)"),
     (["nope"], "contourgrasp: error: argument command: invalid choice: 'nope' (choose from 'hands', 'synth', 'plan', "
-               "'bench', 'calibrate', 'ros', 'efd') (see contourgrasp --help)"),
+               "'bench', 'calibrate', 'hand-from-model', 'ros', 'efd') (see contourgrasp --help)"),
 ])
 def test_argument_errors_are_one_line_naming_help(capsys, argv, line):
     code, out, err = run(capsys, *argv)
@@ -245,7 +245,7 @@ def _value(option):
 
 @st.composite
 def argv_strategy(draw, files, folder):
-    command = draw(st.sampled_from(["synth", "synth", "efd", "plan", "hands", "bench", "calibrate"]))
+    command = draw(st.sampled_from(["synth", "synth", "efd", "plan", "hands", "bench", "calibrate", "hand-from-model"]))
     any_file = st.sampled_from(files + ["example:can", "example:nope", str(folder / "missing.csv")])
     argv = [command]
     if command in ("synth", "efd"):
@@ -257,6 +257,8 @@ def argv_strategy(draw, files, folder):
         argv += ["--mesh", draw(any_file), "--planners", draw(st.sampled_from(["nope", ""])), "--trials", "1"]
     if command == "calibrate":  # never simulates: every hand here is malformed or refused
         argv += ["--hand", draw(any_file | st.just("five-finger-curved-thumb"))]
+    if command == "hand-from-model":  # never simulates: every model here is malformed or missing
+        argv += [draw(any_file), "--fingertips", "tip", *draw(st.sampled_from([[], ["--palm", "palm"]]))]
     if command in ("synth", "plan"):
         argv += ["--yaw-step-deg", draw(_value("--yaw-step-deg"))]  # bounds the grid unless the value is refused
         for option in draw(st.lists(st.sampled_from(sorted(FAST_VALUES) + SWITCHES + FILE_OPTIONS), max_size=6)):
@@ -268,11 +270,11 @@ def argv_strategy(draw, files, folder):
                 argv += [option, draw(_value(option) | any_file if option in FILE_OPTIONS else _value(option))]
     if command == "efd":
         argv += ["--harmonics", *draw(st.lists(_value("--harmonics"), min_size=1, max_size=3))]
-    if command in ("synth", "plan", "efd", "calibrate") and draw(st.booleans()):
+    if command in ("synth", "plan", "efd", "calibrate") and draw(st.booleans()) or command == "hand-from-model":
         own_inputs = [a for a in argv if a in files]  # an output naming an input must be refused
         targets = st.sampled_from([str(folder / "out.json"), str(folder / "adir"), str(folder / "no" / "x.json"),
                                    *own_inputs])
-        argv += [draw(st.sampled_from(["--out", "--plot"])), draw(targets)]
+        argv += [draw(st.sampled_from(["--out"] if command == "hand-from-model" else ["--out", "--plot"])), draw(targets)]
     return argv
 
 
@@ -293,3 +295,48 @@ def test_fuzz_the_command_line_never_tracebacks(fuzz_files):
 
     check()
     assert {p: Path(p).read_bytes() for p in files} == before  # no input was ever overwritten
+
+
+# --- hand-from-model (issue 19) ---
+
+@pytest.mark.parametrize("model", ["inspire", "jaco-three-finger"])
+def test_hand_from_model_writes_a_hand_that_plans(tmp_path, capsys, model):
+    hand = tmp_path / "hand.toml"
+    code, out, err = run(capsys, "hand-from-model", model, "--out", hand)
+    assert code == 0, err
+    assert "fit error mm" in out and f"hand -> {hand}" in out
+    code, out, err = run(capsys, "synth", "--contour", "example:can", "--hand", hand, *FAST, "--out",
+                         tmp_path / "plan.json")
+    assert code == 0, err
+    assert json.loads((tmp_path / "plan.json").read_text())["hand"] == model
+
+
+def test_hand_from_model_bad_input_is_one_line_and_writes_nothing(tmp_path, capsys):
+    model = Path(__file__).parent / "sim" / "fixtures" / "two-sliders.xml"
+    broken = tmp_path / "broken.xml"
+    broken.write_text("<mujoco><worldbody><body></mujoco>")
+    out = tmp_path / "hand.toml"
+    cases = [
+        ([model, "--fingertips", "left_tip", "thumb_tip"], "no site or body named 'thumb_tip'"),
+        ([model, "--fingertips", "left_tip", "right_tip", "--actuators", "right_drive"],
+         "fingertip 'left_tip' does not move"),
+        ([model, "--fingertips", "left_tip", "right_tip", "--palm", "plate"], "palm 'plate' is not a body (a geom)"),
+        ([broken, "--fingertips", "tip"], "broken.xml: cannot load the MuJoCo model"),
+        ([tmp_path / "missing.xml", "--fingertips", "tip"], "no such model file"),
+    ]
+    for argv, message in cases:
+        code, _, err = run(capsys, "hand-from-model", *argv, "--out", out)
+        assert code == 2 and message in err and len(err.strip().splitlines()) == 1, err
+        assert not out.exists()
+
+
+def test_bench_on_a_hand_model_runs_and_refuses_mixed_options(tmp_path, capsys):
+    code, out, err = run(capsys, "bench", "--hand-model", "jaco-three-finger", "--objects", "can", "--trials", "1",
+                         "--planners", "default", "--workers", "1", "--out", tmp_path / "bench")
+    assert code == 0, err
+    assert "| default |" in out and (tmp_path / "bench" / "trials.json").exists()
+    for argv, message in [(["--hand-model", "inspire", "--hand", "three-finger"], "give --hand or --hand-model"),
+                          (["--fingertips", "tip"], "--fingertips needs --hand-model")]:
+        code, _, err = run(capsys, "bench", *argv, "--objects", "can", "--trials", "1", "--out", tmp_path / "other")
+        assert code == 2 and message in err and len(err.strip().splitlines()) == 1, err
+        assert not (tmp_path / "other").exists()

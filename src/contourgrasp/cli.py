@@ -25,6 +25,8 @@ from .io.planner_file import load_planner, planner_names, synthesis_options
 from .io.plan_file import atomic_outputs, plan_to_dict, write_json
 
 EXIT_OK, EXIT_INPUT, EXIT_INFEASIBLE = 0, 2, 3
+#: The palm axes hand-from-model and bench --hand-model accept as the approach.
+APPROACHES = ("x", "-x", "y", "-y", "z", "-z")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -152,6 +154,7 @@ def _parser() -> argparse.ArgumentParser:
 
     _add_bench_parser(sub)
     _add_calibrate_parser(sub)
+    _add_hand_from_model_parser(sub)
     ros = sub.add_parser("ros", help="run the ROS 2 node contourgrasp (needs contourgrasp[ros])")
     ros.add_argument("--ros-args", nargs=argparse.REMAINDER, default=[], metavar="ARG",
                      help="ROS arguments: -p NAME:=VALUE, -r FROM:=TO, --params-file FILE, ...")
@@ -232,7 +235,7 @@ def _add_bench_parser(sub) -> None:
     objects.add_argument("--mesh", nargs="+", metavar="FILE", help="OBJ/STL mesh files in meters, z up, instead")
     bench.add_argument("--trials", type=_positive_int, default=20, help="trials per object and planner")
     bench.add_argument("--seed", type=_non_negative_int, default=0, help="trial t uses seed SEED + t")
-    bench.add_argument("--hand", default="five-finger-linear", help="preset name or hand TOML file (ray fingers)")
+    bench.add_argument("--hand", help="preset name or hand TOML file (ray fingers) (default: five-finger-linear)")
     bench.add_argument("--planners", default="paper,default,centroid-principal-axis,random",
                        help="comma-separated planner names: presets, baselines, ablation steps or planner TOML files")
     bench.add_argument("--ablation", action="store_true",
@@ -247,6 +250,13 @@ def _add_bench_parser(sub) -> None:
                             "(pip install 'contourgrasp[cluster]')")
     bench.add_argument("--resume", metavar="DIR",
                        help="continue the bench whose outputs are in DIR (same settings), keeping its trials")
+    bench.add_argument("--hand-model", metavar="MODEL",
+                       help="simulate this MuJoCo hand model (MJCF file, or inspire, jaco-three-finger) and plan with "
+                            "the hand file derived from it (see hand-from-model), instead of --hand")
+    bench.add_argument("--fingertips", nargs="+", metavar="SITE|BODY", help="with --hand-model FILE: see hand-from-model")
+    bench.add_argument("--actuators", nargs="+", metavar="NAME", help="with --hand-model: see hand-from-model")
+    bench.add_argument("--palm", metavar="BODY", help="with --hand-model: see hand-from-model")
+    bench.add_argument("--approach", choices=APPROACHES, help="with --hand-model: see hand-from-model")
 
 
 def _add_calibrate_parser(sub) -> None:
@@ -254,6 +264,21 @@ def _add_calibrate_parser(sub) -> None:
     calibrate.add_argument("--hand", default="five-finger-linear", help="preset name or hand TOML file (ray fingers)")
     calibrate.add_argument("--reference", help="finger given lambda_virt 0 (default: the one that closes last)")
     calibrate.add_argument("--out", help="write the hand TOML with the calibrated virtual starts here")
+
+
+def _add_hand_from_model_parser(sub) -> None:
+    derive = sub.add_parser("hand-from-model", help="derive a hand file by closing a MuJoCo hand model (MJCF)")
+    derive.add_argument("model", metavar="MODEL", help="MJCF file, or a bundled model: inspire, jaco-three-finger")
+    derive.add_argument("--fingertips", nargs="+", metavar="SITE|BODY",
+                        help="one site or body per finger (required for a file)")
+    derive.add_argument("--actuators", nargs="+", metavar="NAME",
+                        help="the synergy's actuators, driven together from the low to the high end of their "
+                             "ctrlrange (default: all on the palm; 'all')")
+    derive.add_argument("--palm", metavar="BODY", help="the palm body (default: the deepest body holding every "
+                                                       "fingertip)")
+    derive.add_argument("--approach", choices=APPROACHES,
+                        help="the palm body's axis toward the object (default: the axis the fingers point along)")
+    derive.add_argument("--out", required=True, help="the hand TOML to write")
 
 
 def _plan_options(args) -> dict:
@@ -469,8 +494,10 @@ def _bench(args) -> int:
         from .sim.planners import ablation_planners
 
         planners += [p.name for p in ablation_planners()[1:-1] if p.name not in planners]
-    setup = bench.Bench(objects=objects, planners=planners, trials=args.trials, seed=args.seed,
-                        hand=load_hand(args.hand), noise=args.noise, splits=splits)
+    mounted = _hand_model(args)
+    hand = load_hand(args.hand or "five-finger-linear") if mounted is None else mounted.hand
+    setup = bench.Bench(objects=objects, planners=planners, trials=args.trials, seed=args.seed, hand=hand,
+                        noise=args.noise, splits=splits, hand_model=mounted)
     journal, done = bench.resume(out, setup) if args.resume is not None else (None, ())
     with bench.executor(setup, workers=args.workers, ray=args.ray is not None, address=args.ray or None) as run:
         if journal is None:
@@ -483,6 +510,21 @@ def _bench(args) -> int:
     kept = f" ({len(done)} kept from {out / bench.JOURNAL})" if done else ""
     print(f"{len(results)} trials{kept} in {time.perf_counter() - started:.0f} s -> {', '.join(map(str, paths))}")
     return EXIT_OK
+
+
+def _hand_model(args):
+    """The bench's mounted hand model (``--hand-model``), or None for the hand built from ``--hand``."""
+    given = [f"--{name}" for name in ("fingertips", "actuators", "palm", "approach") if getattr(args, name) is not None]
+    if args.hand_model is None:
+        if given:
+            raise InputError(f"{given[0]} needs --hand-model")
+        return None
+    if args.hand is not None:
+        raise InputError("give --hand or --hand-model, not both (the model's hand file is derived from it)")
+    from .sim.model_mount import mount_model
+
+    return mount_model(args.hand_model, fingertips=args.fingertips, actuators=args.actuators, palm=args.palm,
+                       approach=args.approach)
 
 
 def _calibrate(args) -> int:
@@ -498,6 +540,22 @@ def _calibrate(args) -> int:
         with atomic_outputs(args.out, inputs=_inputs(args)) as (out,):
             out.write_text(hand_to_toml(calibration.calibrated_hand(), comment=comment), encoding="utf-8")
         print(f"calibrated hand -> {args.out}")
+    return EXIT_OK
+
+
+def _hand_from_model(args) -> int:
+    from .io.hand_file import hand_to_toml
+    from .sim.model_hand import derive_hand, fit_table
+
+    derivation = derive_hand(args.model, fingertips=args.fingertips, actuators=args.actuators, palm=args.palm,
+                             approach=args.approach)
+    print("\n".join(fit_table(derivation)))
+    comment = "\n".join([f"Derived by `contourgrasp hand-from-model` from {Path(args.model).name}: fit errors (mm)",
+                          *(f"  {fit.name}: {fit.kind} {1000 * fit.error:.2f}" for fit in derivation.fits),
+                          *derivation.notes])
+    with atomic_outputs(args.out, inputs=[*_inputs(args), args.model]) as (out,):
+        out.write_text(hand_to_toml(derivation.hand, comment=comment), encoding="utf-8")
+    print(f"hand -> {args.out}")
     return EXIT_OK
 
 
@@ -518,7 +576,7 @@ def _efd(args) -> int:
 
 
 COMMANDS = {"hands": _hands, "synth": _synth, "plan": _plan, "bench": _bench, "efd": _efd,
-            "calibrate": _calibrate, "ros": _ros}
+            "calibrate": _calibrate, "ros": _ros, "hand-from-model": _hand_from_model}
 
 
 def main(argv=None) -> int:

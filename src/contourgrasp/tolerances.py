@@ -358,7 +358,8 @@ MAX_GRASP_HEIGHT_FRACTION = 0.7
 MIN_SECTION_CELLS = 50
 
 #: The small-object rule (pipeline.plan_frame(small_objects=True)): the fewest touching fingers it plans with (at
-#: least the hand's required ones): the thumb against two fingers. Chosen on ycb-train (README, "3-D hand").
+#: least the hand's required ones): the thumb against one finger. Chosen on ycb-train (README, "3-D hand"): with
+#: three, the strawberry still had no plan.
 SMALL_OBJECT_TOUCHING = 2
 
 #: Closing sweep (synthesis.sweep): closing progresses sampled per finger, and how much earlier than its tip's ball
@@ -369,3 +370,10 @@ SWEEP_TOLERANCE = 0.005
 #: A capsule axis with 1 - u_z^2 below this is vertical (synthesis descent and sweep kernels): its lowest points
 #: on a vertical line are its end balls'.
 VERTICAL_AXIS = 1e-12
+
+
+# --- hand models (sim.model_hand) ---
+
+#: Largest distance (m) of a MuJoCo model's fingertip path, projected on the palm plane, from the ray or
+#: elliptic arc fitted to it; a finger fitting neither within this is refused by hand-from-model.
+MODEL_FIT_TOLERANCE = 3e-3

@@ -10,6 +10,8 @@
 * :mod:`~contourgrasp.sim.planners` -- the library's pipeline as trial planners, and two baselines
 * :mod:`~contourgrasp.sim.bench` -- Table 4.4 as a benchmark (``contourgrasp bench``), with its figures
 * :mod:`~contourgrasp.sim.calibrate` -- virtual starts from the simulated hand's closing
+* :mod:`~contourgrasp.sim.model_hand` -- a hand file from a MuJoCo hand model (``hand-from-model``)
+* :mod:`~contourgrasp.sim.model_mount` -- that model as the simulated hand (``bench --hand-model``)
 
 Needs ``mujoco`` (4.x: ``mj_multiRay`` takes a ``normal`` argument), ``trimesh``
 and ``coacd``; nothing here uses OpenGL (``MUJOCO_GL`` defaults to ``disable``).
@@ -23,6 +25,8 @@ Example::
 
 from .hand_model import TIMINGS, ChainRule, FingerTiming, HandDesign, HandModel, build_hand, derive_body
 from .measure import fingertip_path_error, fingertip_paths
+from .model_hand import MODELS, Derivation, FingerFit, ModelSpec, derive_hand, fit_finger
+from .model_mount import MountedHand, mount_model
 from .objects import THESIS_OBJECTS, ObjectSpec, Part, mesh_object, object_spec
 from .render import DepthNoise, object_truth, render, render_view, tilted_view
 from ..perception import Intrinsics
@@ -31,7 +35,7 @@ from .trial import (DROPPED, FAILURE_CAUSES, NO_PLAN, PUSHED, SLIPPED, STRUCK, E
                     execute_grasp, hand_pose_from_matrix, pose_matrix, run_trial, scripted_grasp)
 
 __all__ = [
-    "Camera", "ChainRule", "DROPPED", "DepthNoise", "Execution", "FAILURE_CAUSES", "FingerTiming", "GraspOutcome", "HandDesign",
+    "Camera", "ChainRule", "Derivation", "FingerFit", "MODELS", "ModelSpec", "derive_hand", "fit_finger", "MountedHand", "mount_model", "DROPPED", "DepthNoise", "Execution", "FAILURE_CAUSES", "FingerTiming", "GraspOutcome", "HandDesign",
     "HandModel", "Intrinsics", "NO_PLAN", "ObjectSpec", "PUSHED", "Part", "Placement", "SLIPPED", "SR300", "STRUCK",
     "Scene", "THESIS_OBJECTS", "TIMINGS", "TrialRecord", "Workspace", "build_hand", "build_scene", "derive_body", "execute_grasp",
     "fingertip_path_error", "fingertip_paths", "hand_pose_from_matrix", "mesh_object", "object_spec", "object_truth",

@@ -260,12 +260,7 @@ class HandModel:
         t = self.hand.palm.thickness
         contact = f'contype="{HAND_BIT}" conaffinity="{TABLE_BIT}" group="2"'
         lines = [
-            '<body name="hand_base" gravcomp="1">',
-            '  <joint name="hand_x" type="slide" axis="1 0 0" damping="20"/>',
-            '  <joint name="hand_y" type="slide" axis="0 1 0" damping="20"/>',
-            '  <joint name="hand_z" type="slide" axis="0 0 1" damping="20"/>',
-            '  <joint name="hand_yaw" type="hinge" axis="0 0 -1" damping="1"/>',
-            '  <body name="palm" quat="0 1 0 0" gravcomp="1">',  # hand frame: x, -y, -z of the world at yaw 0
+            *BASE_XML,
             f'    <geom name="palm" type="box" size="{_f((x1 - x0) / 2)} {_f((y1 - y0) / 2)} {_f(t / 2)}" '
             f'pos="{_f((x0 + x1) / 2)} {_f((y0 + y1) / 2)} {_f(-t / 2)}" mass="{_f(d.palm_mass)}" '
             f'rgba="0.25 0.25 0.28 1" {contact}/>',
@@ -326,13 +321,30 @@ class HandModel:
 
     def actuator_xml(self) -> str:
         """The tendon motor (control: force fraction in [0, 1]) and the base's position servos."""
-        (kp_lin, kp_yaw), (kv_lin, kv_yaw) = self.design.base_kp, self.design.base_kv
-        servo = ('<position name="{0}" joint="{0}" kp="{1}" kv="{2}" ctrlrange="-10 10"/>')
         return "\n".join([
             f'<motor name="flexion" tendon="flexion" gear="{_f(self.design.max_tendon_force)}" ctrlrange="0 1"/>',
-            *(servo.format(j, _f(kp_lin), _f(kv_lin)) for j in ("hand_x", "hand_y", "hand_z")),
-            servo.format("hand_yaw", _f(kp_yaw), _f(kv_yaw)),
+            base_servos_xml(self.design),
         ])
+
+
+#: The opening lines of a hand's body: the x, y, z, yaw base, and the palm body in the hand frame
+#: (x, -y, -z of the world at yaw 0), left open for the palm's contents and two closing tags.
+BASE_XML = (
+    '<body name="hand_base" gravcomp="1">',
+    '  <joint name="hand_x" type="slide" axis="1 0 0" damping="20"/>',
+    '  <joint name="hand_y" type="slide" axis="0 1 0" damping="20"/>',
+    '  <joint name="hand_z" type="slide" axis="0 0 1" damping="20"/>',
+    '  <joint name="hand_yaw" type="hinge" axis="0 0 -1" damping="1"/>',
+    '  <body name="palm" quat="0 1 0 0" gravcomp="1">',
+)
+
+
+def base_servos_xml(design: HandDesign) -> str:
+    """The position servos of the hand's base joints (x, y, z, yaw)."""
+    (kp_lin, kp_yaw), (kv_lin, kv_yaw) = design.base_kp, design.base_kv
+    servo = '<position name="{0}" joint="{0}" kp="{1}" kv="{2}" ctrlrange="-10 10"/>'
+    return "\n".join([*(servo.format(j, _f(kp_lin), _f(kv_lin)) for j in ("hand_x", "hand_y", "hand_z")),
+                      servo.format("hand_yaw", _f(kp_yaw), _f(kv_yaw))])
 
 
 def build_hand(hand: Hand, *, design: HandDesign = HandDesign(), timing: str = "thesis") -> HandModel:

@@ -127,7 +127,11 @@ class Scene:
         self._base_qpos = np.array([model.joint(j).qposadr[0] for j in BASE_JOINTS])
         self._base_ctrl = np.array([model.actuator(j).id for j in BASE_JOINTS])
         self._base_dofs = np.array([model.joint(j).dofadr[0] for j in BASE_JOINTS])
-        self._tendon_ctrl = model.actuator("flexion").id
+        synergy = getattr(hand, "synergy", None)  # a mounted hand model (sim.model_mount) closes many actuators
+        self._closing = synergy(model) if synergy else (np.array([model.actuator("flexion").id]), np.zeros(1),
+                                                        np.ones(1))
+        for actuator, value in getattr(hand, "held", lambda _: [])(model):
+            data.ctrl[actuator] = value
 
     @property
     def time(self) -> float:
@@ -160,9 +164,11 @@ class Scene:
             mujoco.mj_forward(self.model, self.data)
 
     def command(self, base_target, closing: float) -> None:
-        """Servo targets for the hand base (x, y, z, yaw) and the tendon force fraction."""
+        """Servo targets for the hand base (x, y, z, yaw) and the closing (the tendon force fraction, or a mounted
+        hand model's synergy: 0 open, 1 closed)."""
         self.data.ctrl[self._base_ctrl] = base_target
-        self.data.ctrl[self._tendon_ctrl] = closing
+        actuators, open_, closed = self._closing
+        self.data.ctrl[actuators] = open_ + closing * (closed - open_)
 
     def step(self, duration: float | None = None) -> None:
         """Advance the simulation by ``duration`` s (one time step if None) at the current commands."""
@@ -214,26 +220,36 @@ def build_scene(obj, *, seed: int, hand: Hand | str = "five-finger-linear", desi
         An object, a name of :data:`~contourgrasp.sim.objects.THESIS_OBJECTS` or a mesh path.
     seed : int
         Chooses the placement.
-    hand : Hand or str
-        A preset name, hand TOML path or :class:`Hand` with ray fingers.
+    hand : Hand, str or MountedHand
+        A preset name, hand TOML path or :class:`Hand` with ray fingers; or a hand model mounted
+        by :func:`~contourgrasp.sim.model_mount.mount_model`, simulated as itself.
     design, timing
         See :func:`~contourgrasp.sim.hand_model.build_hand`.
     camera : Camera
     workspace : Workspace
     """
     obj = object_spec(obj)
-    hand_model = build_hand(load_hand(hand), design=design, timing=timing)
+    hand_model = hand if hasattr(hand, "mount") else build_hand(load_hand(hand), design=design, timing=timing)
     rng = np.random.default_rng(np.random.SeedSequence([seed, 0]))
     placement = Placement(x=float(rng.uniform(-workspace.half_x, workspace.half_x)),
                           y=float(rng.uniform(-workspace.half_y, workspace.half_y)),
                           yaw=float(rng.uniform(0.0, 2 * np.pi)))
     with mujoco_warnings():
-        model = mujoco.MjModel.from_xml_string(scene_xml(obj, hand_model, placement))
+        model = _compile(scene_xml(obj, hand_model, placement), hand_model)
         data = mujoco.MjData(model)
     scene = Scene(model, data, obj, hand_model, camera, placement)
     scene.set_hand(0.0, 0.0, PARK_HEIGHT, 0.0)
     scene.step(SETTLE_TIME)
     return scene
+
+
+def _compile(xml: str, hand) -> mujoco.MjModel:
+    """The scene's model; a mounted hand model is attached to the parsed scene before compiling."""
+    if not hasattr(hand, "mount"):
+        return mujoco.MjModel.from_xml_string(xml)
+    spec = mujoco.MjSpec.from_string(xml)
+    hand.mount(spec)
+    return spec.compile()
 
 
 def scene_xml(obj: ObjectSpec, hand: HandModel, placement: Placement) -> str:

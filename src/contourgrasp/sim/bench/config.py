@@ -47,6 +47,9 @@ class Bench:
         Named object sets (``ycb-train``, ``ycb-test``, ...) and the names of
         their objects, for the per-split report; empty: no split, the thesis's
         report.
+    hand_model : MountedHand, optional
+        A MuJoCo hand model simulated as itself (:func:`~contourgrasp.sim.model_mount.mount_model`);
+        ``hand`` is then its derived hand file. None: the simulated hand is built from ``hand``.
 
     Raises
     ------
@@ -65,6 +68,7 @@ class Bench:
     camera: Camera = field(default_factory=Camera)
     workspace: Workspace = field(default_factory=Workspace)
     splits: tuple[tuple[str, tuple[str, ...]], ...] = ()
+    hand_model: object = None
 
     def __post_init__(self):
         object.__setattr__(self, "objects", tuple(self.objects))
@@ -86,7 +90,8 @@ class Bench:
             if missing or not members:
                 raise SimulationError(f"split {split!r} names {missing[0] if missing else 'no object'}, "
                                       f"which the bench does not run")
-        build_hand(self.hand)  # refuses a hand the simulation cannot build before any trial runs
+        if self.hand_model is None:
+            build_hand(self.hand)  # refuses a hand the simulation cannot build before any trial runs
 
     @property
     def size(self) -> int:
@@ -109,7 +114,8 @@ class Bench:
     def run(self, planner: str, obj: ObjectSpec, trial: int, *, plan=None, observe=None) -> TrialRecord:
         """Run one trial; ``plan`` replaces the named planner's callable (same answers), ``observe`` see run_trial."""
         seed = self.seed + trial
-        return run_trial(obj, seed=seed, planner=plan or make_planner(planner, self.hand, seed=seed), hand=self.hand,
+        return run_trial(obj, seed=seed, planner=plan or make_planner(planner, self.hand, seed=seed),
+                         hand=self.hand if self.hand_model is None else self.hand_model,
                          noise=self.noise, camera=self.camera, workspace=self.workspace, observe=observe)
 
 

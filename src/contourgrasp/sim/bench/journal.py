@@ -43,6 +43,8 @@ def settings(bench: Bench) -> dict:
         "noise": bench.noise,
         "camera": digest(bench.camera),
         "workspace": digest(bench.workspace),
+        **({} if bench.hand_model is None else
+           {"hand model": f"{Path(bench.hand_model.path).name} {digest(bench.hand_model.derivation.mount)}"}),
     }
 
 

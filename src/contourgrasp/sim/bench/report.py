@@ -146,11 +146,18 @@ def markdown(bench: Bench, results, *, wall_time: float, kept: int = 0) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _simulated(bench: Bench) -> str:
+    """How the bench's hand is simulated, for the report's first paragraph."""
+    if bench.hand_model is None:
+        return "one tendon, the thesis's finger timing"
+    return f"the MuJoCo model {Path(bench.hand_model.path).name} simulated as itself, closed by one synergy"
+
+
 def _trials_text(bench: Bench, n_trials: int, wall_time: float, kept: int) -> str:
     resumed = f" ({kept} of them run earlier and kept by --resume)" if kept else ""
     return (f"{len(bench.objects)} object(s) x {bench.trials} trial(s) x {len(bench.planners)} planner(s) = "
-            f"{n_trials} trials in {wall_time:.0f} s wall time{resumed}. Hand `{bench.hand.name}` (one tendon, the "
-            f"thesis's finger timing); depth noise {'on' if bench.noise else 'off'}; trial t uses seed {bench.seed} "
+            f"{n_trials} trials in {wall_time:.0f} s wall time{resumed}. Hand `{bench.hand.name}` ({_simulated(bench)}"
+            f"); depth noise {'on' if bench.noise else 'off'}; trial t uses seed {bench.seed} "
             f"+ t, the same scene for every planner.")
 
 

@@ -1,0 +1,746 @@
+"""A hand file from a MuJoCo model of a hand: close it in free air and fit the thesis's trajectories (3.3).
+
+Reading of the model
+--------------------
+*Palm.* The palm body (default: the deepest body holding every fingertip) is fixed: every joint
+outside its subtree is held at its reference position (a free joint, an arm's joints), gravity is
+off (a hand on an arm is gravity-compensated; the bench's hand is) and so are contacts (free air:
+the fingers pass each other, as the bench's hand geoms do).
+
+*Synergy.* The named actuators (default: all whose joints lie on the palm's subtree) are driven
+together, the one-DoF power grasp of the thesis: at synergy ``u`` in [0, 1] every control is
+``open + u * (closed - open)``, the two ends of its ``ctrlrange`` (a position servo's joint angles,
+a motor's or tendon's force). The hand settles open for :data:`SETTLE_TIME`, ``u`` ramps from 0 to
+1 over ``close_time`` and holds for ``hold_time``. *Open* is the low end of every range unless the
+fingertips end farther apart (mean distance from their centroid) than they began: then the run is
+repeated from the high ends to the low ones. A finger is *closed* where its projected tip is
+farthest from where it was open: a curling finger's tip swings back under the palm at the end,
+which no ray or arc follows and an object in the way never sees. Actuators outside the synergy
+keep control 0, except those a :class:`ModelSpec` holds (a pre-shape).
+
+*Frames.* The 3-D hand frame is the palm body's frame with its axes renamed: z (the approach, toward
+the object) is the :class:`ModelSpec`'s ``approach`` axis, or else the palm axis (+-x, +-y or +-z)
+best aligned with the mean direction from each finger's first hinge joint (the palm's origin for a
+finger without one) to its open fingertip -- the way the fingers point; x is the first of the palm's
+axes not along z, y = z x x. The origin is the palm body's origin moved along z to the palm's
+underside: the largest z of the palm's own collision geoms (those of bodies welded to it), but no
+deeper than the shallowest finger's first joint (posts below the palm carry knuckles), so z = 0 is
+the plane of the palm's underside as in :mod:`contourgrasp.hand`; the palm plane is the plane z = 0,
+and the fingertips' paths are projected on it along z.
+
+*Trajectories.* Each fingertip's path, projected on the palm plane, is fitted by a ray (eq 3.18:
+start the open tip, direction and travel to the closed tip) and, when the ray leaves the path by more
+than ``tolerances.MODEL_FIT_TOLERANCE``, by an axis-aligned elliptic arc (eq 3.20, fitted as a conic
+by least squares); the fit error is the largest distance of the path from the fitted trajectory. A
+finger no trajectory fits within the tolerance is refused, naming it.
+
+*Virtual starts* come from the recorded closing, as :mod:`contourgrasp.sim.calibrate` derives them
+for the simulated hand (reference: the finger that closes last).
+
+*3-D chain.* A ray finger whose path from the palm to its tip has exactly two moving hinge joints is
+given a :class:`~contourgrasp.hand.FingerChain`: knuckle at the first joint, links from joint to
+joint to tip, its open and closed joint angles measured in the chain's plane. The hand keeps its
+chains and a palm (the palm geoms' rectangle on the palm plane) only when every finger has one and
+each passes :func:`~contourgrasp.hand.check_chain`; otherwise it is a 2-D hand, and
+:attr:`Derivation.notes` says why. Finger radius: half the smallest extent of the fingertip body's
+collision geoms.
+
+*Gains.* The model says nothing about the planner's gains: every finger gets ``alpha`` 25 and
+``beta`` 10000 (the five-finger preset's), none is required, and ``min_touching`` is every finger
+for up to three fingers, all but one beyond.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, replace
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+os.environ.setdefault("MUJOCO_GL", "disable")
+import mujoco  # noqa: E402
+
+from .. import tolerances as tol  # noqa: E402
+from ..errors import HandError, HandFileError, SimulationError  # noqa: E402
+from ..hand import Arc, Finger, FingerChain, Hand, Palm, Ray, check_chain, polyline_distance  # noqa: E402
+from .calibrate import Closing, derive_virtual_starts  # noqa: E402
+from .scene import TIMESTEP, mujoco_warnings  # noqa: E402
+
+#: Time the open hand settles before closing, s.
+SETTLE_TIME = 2.0
+#: Default gains of a derived hand (the five-finger-linear preset's).
+ALPHA, BETA, MISS_PENALTY = 25.0, 10000.0, 250.0
+
+
+@dataclass(frozen=True)
+class ModelSpec:
+    """Where a hand model is and how to read it: the MJCF file, its fingertips, synergy actuators, palm.
+
+    Attributes
+    ----------
+    path : str
+    fingertips : tuple of str
+        Site or body names, one per finger (a body stands for its origin).
+    actuators : tuple of str or None
+        The synergy's actuators; None: all on the palm's subtree.
+    palm : str or None
+        The palm body; None: the deepest body holding every fingertip.
+    names : tuple of str or None
+        Finger names in the hand file; None: the fingertips' names.
+    hold : tuple of (str, float)
+        Actuators outside the synergy held at a fraction of their control range throughout (a
+        pre-shape, such as a thumb's opposition); any other actuator keeps control 0.
+    approach : str or None
+        The palm axis (``"x"``, ``"-x"``, ..., ``"-z"``) that is the approach (the hand frame's z);
+        None: the axis the fingers point along (module docstring).
+    """
+
+    path: str
+    fingertips: tuple[str, ...]
+    actuators: tuple[str, ...] | None = None
+    palm: str | None = None
+    names: tuple[str, ...] | None = None
+    hold: tuple[tuple[str, float], ...] = ()
+    approach: str | None = None
+
+
+def _bundled(folder: str, xml: str, fingers, **options) -> ModelSpec:
+    path = resources.files("contourgrasp").joinpath(f"data/models/{folder}/{xml}")
+    return ModelSpec(path=str(path), fingertips=tuple(f"{f}_tip" for f in fingers), **options)
+
+
+_INSPIRE_FINGERS = ("thumb", "index", "middle", "ring", "pinky")
+
+#: The hand models shipped with the package (from robosuite 1.5.2, MIT; data/models/README.md). The
+#: Inspire hand's thumb rotation is its own motor: held opposed (the high end), not part of the synergy.
+MODELS = {
+    "inspire": _bundled(
+        "inspire", "inspire_right_hand.xml", _INSPIRE_FINGERS, palm="r_palm",
+        names=("thumb", "index", "middle", "ring", "little"),
+        actuators=tuple(f"{f}_{j}_drive" for f in _INSPIRE_FINGERS[1:] for j in ("proximal", "distal"))
+        + ("thumb_proximal_2_drive", "thumb_middle_drive", "thumb_distal_drive"),
+        hold=(("thumb_proximal_1_drive", 1.0),)),
+    "jaco-three-finger": _bundled("jaco_three_finger", "jaco_three_finger_gripper.xml", ("thumb", "index", "pinky"),
+                                  palm="right_gripper", names=("thumb", "index", "pinky")),
+}
+
+
+def model_spec(model, *, fingertips=None, actuators=None, palm=None, approach=None) -> ModelSpec:
+    """A :class:`ModelSpec` from a bundled model's name (:data:`MODELS`) or an MJCF path; options override.
+
+    Raises
+    ------
+    HandFileError
+        A path without fingertips.
+    """
+    if isinstance(model, ModelSpec):
+        spec = model
+    elif str(model) in MODELS:
+        spec = MODELS[str(model)]
+    else:
+        if not fingertips:
+            raise HandFileError(f"{model}: name the fingertips (sites or bodies) of the model")
+        spec = ModelSpec(path=str(model), fingertips=tuple(fingertips))
+        fingertips = None
+    if fingertips:
+        spec = replace(spec, fingertips=tuple(fingertips), names=None)
+    if actuators is not None:
+        spec = replace(spec, actuators=tuple(actuators))
+    if approach is not None:
+        spec = replace(spec, approach=approach)
+    return replace(spec, palm=palm) if palm is not None else spec
+
+
+@dataclass(frozen=True)
+class FingerFit:
+    """How one fingertip's projected path was fitted.
+
+    Attributes
+    ----------
+    name : str
+    kind : str
+        ``"ray"`` or ``"arc"``.
+    error : float
+        Largest distance of the projected path from the fitted trajectory, m.
+    ray_error : float
+        That distance for the ray (the first fit tried), m.
+    """
+
+    name: str
+    kind: str
+    error: float
+    ray_error: float
+
+
+@dataclass(frozen=True)
+class Derivation:
+    """A hand derived from a model: the hand, each finger's fit, and what was left out.
+
+    Attributes
+    ----------
+    hand : Hand
+    fits : tuple of FingerFit
+    notes : tuple of str
+        Why the hand has no 3-D chains, when it has none.
+    mount : Mount
+        How the simulation mounts and closes the model (:mod:`contourgrasp.sim.model_mount`).
+    """
+
+    hand: Hand
+    fits: tuple[FingerFit, ...]
+    notes: tuple[str, ...]
+    mount: Mount
+
+
+@dataclass(frozen=True)
+class Mount:
+    """Where the model's palm sits in the 3-D hand frame and how its synergy was driven.
+
+    Attributes
+    ----------
+    palm : str
+        The palm body.
+    rotation : (3, 3) float
+        The palm body's axes in the hand frame (columns): ``v_hand = rotation @ v_palm + position``.
+    position : (3,) float
+        The palm body's origin in the hand frame, m.
+    actuators : tuple of str
+        The synergy's actuators.
+    open_controls, closed_controls : tuple of float
+        Their controls with the hand open and closed.
+    held : tuple of (str, float)
+        Actuators outside the synergy and the controls they hold.
+    finger_bodies : tuple of (str, int)
+        Each body of a finger (the palm's children toward a fingertip and all below them) and the
+        finger's index.
+    tip_depth : float
+        The fingertips' largest depth below the palm's underside while closing, m.
+    """
+
+    palm: str
+    rotation: tuple[tuple[float, float, float], ...]
+    position: tuple[float, float, float]
+    actuators: tuple[str, ...]
+    open_controls: tuple[float, ...]
+    closed_controls: tuple[float, ...]
+    held: tuple[tuple[str, float], ...]
+    finger_bodies: tuple[tuple[str, int], ...]
+    tip_depth: float
+
+
+@dataclass(frozen=True, eq=False)
+class ClosedModel:
+    """A model closed in free air: per finger the tips in the hand frame over time, and its moving joints.
+
+    Attributes
+    ----------
+    names : tuple of str
+    times : (k,) float
+        Seconds since the synergy began to ramp (0: the settled open hand).
+    tips : (n, k, 3) float
+        Fingertips in the 3-D hand frame (z toward the object), m.
+    joints : tuple of (j, k, 3) float
+        Per finger, the anchors of its moving hinge joints (palm to tip) over time, hand frame.
+    radius : (n,) float
+    palm : Palm or None
+        The palm geoms' rectangle on the palm plane and their thickness; None without palm geoms.
+    mount : Mount
+    """
+
+    names: tuple[str, ...]
+    times: np.ndarray
+    tips: np.ndarray
+    joints: tuple[np.ndarray, ...]
+    radius: np.ndarray
+    palm: Palm | None
+    mount: Mount
+
+
+def load_model(path) -> mujoco.MjModel:
+    """The compiled MuJoCo model of an MJCF file; HandFileError naming the file when it cannot load."""
+    path = Path(path)
+    if not path.is_file():
+        raise HandFileError(f"{path}: no such model file")
+    try:
+        with mujoco_warnings():
+            return mujoco.MjModel.from_xml_path(str(path))
+    except (ValueError, RuntimeError) as err:
+        reason = " ".join(str(err).split())[:300]
+        raise HandFileError(f"{path}: cannot load the MuJoCo model ({reason})") from None
+
+
+def derive_hand(model, *, fingertips=None, actuators=None, palm=None, approach=None, name: str | None = None,
+                close_time: float = 1.0, hold_time: float = 0.5) -> Derivation:
+    """Close a MuJoCo hand model with one synergy and fit its hand file (module docstring).
+
+    Parameters
+    ----------
+    model : str, Path or ModelSpec
+        A bundled model's name (:data:`MODELS`) or an MJCF file.
+    fingertips, actuators, palm, approach
+        Override the :class:`ModelSpec`'s (fingertips are required for a file).
+    name : str, optional
+        The hand's name; default the model file's stem.
+    close_time, hold_time : float
+        Synergy ramp and hold, s.
+
+    Returns
+    -------
+    Derivation
+
+    Raises
+    ------
+    HandFileError
+        The model cannot be loaded, a fingertip, actuator or palm it does not have, or an actuator
+        without a control range.
+    HandError
+        A fingertip the actuators do not move, or a path no ray or arc fits (naming the finger).
+    SimulationError
+        The model is unstable while closing.
+    """
+    spec = model_spec(model, fingertips=fingertips, actuators=actuators, palm=palm, approach=approach)
+    closed = close_model(spec, close_time=close_time, hold_time=hold_time)
+    fingers, fits, ends = [], [], []
+    for i, finger_name in enumerate(closed.names):
+        path = closed.tips[i, :, :2]
+        ends.append(int(np.argmax(np.linalg.norm(path - path[0], axis=1))))
+        finger, fit = fit_finger(finger_name, path[:ends[-1] + 1], radius=float(closed.radius[i]))
+        fingers.append(finger)
+        fits.append(fit)
+    default_name = str(model) if isinstance(model, str) and model in MODELS else Path(spec.path).stem
+    hand = Hand(name=name or default_name, fingers=tuple(fingers), min_touching=_min_touching(len(fingers)),
+                miss_penalty=MISS_PENALTY, description=f"derived from {Path(spec.path).name} by hand-from-model")
+    hand = _with_virtual_starts(hand, closed)
+    hand, notes = _with_chains(hand, closed, ends)
+    return Derivation(hand=hand, fits=tuple(fits), notes=notes, mount=closed.mount)
+
+
+def _min_touching(n: int) -> int:
+    return n if n <= 3 else n - 1
+
+
+def close_model(spec: ModelSpec, *, close_time: float = 1.0, hold_time: float = 0.5) -> ClosedModel:
+    """Load, fix the palm, close the synergy in free air and record the fingertips (module docstring)."""
+    source = spec.path
+    m = load_model(source)
+    m.opt.gravity[:] = 0.0
+    m.opt.timestep, m.opt.integrator = TIMESTEP, mujoco.mjtIntegrator.mjINT_IMPLICITFAST  # the scene's
+    collides = (m.geom_contype != 0) | (m.geom_conaffinity != 0)
+    m.geom_contype[:] = m.geom_conaffinity[:] = 0  # free air: nothing to touch, fingers pass each other (as in the scene)
+    palm = _palm_body(m, spec, source)
+    subtree = _subtree(m, palm)
+    tips = [_fingertip(m, name, subtree, source) for name in spec.fingertips]
+    acts = _actuators(m, spec.actuators, subtree, source)
+    held = _held(m, spec, subtree, source)
+    chains = [_moving_path(m, tip, palm) for tip in tips]
+    run = _Run(m, palm, tips, chains, frozen=[j for j in range(m.njnt) if m.jnt_bodyid[j] not in subtree],
+               steps=tuple(max(1, round(t / m.opt.timestep)) for t in (SETTLE_TIME, close_time, hold_time)))
+    lo, hi = m.actuator_ctrlrange[acts, 0], m.actuator_ctrlrange[acts, 1]
+    tips_palm, joint_records, d = run(acts, lo, hi, held, source)
+    if _spread(tips_palm[:, -1]) > _spread(tips_palm[:, 0]):  # the high ends open the hand: close toward the low
+        lo, hi = hi, lo
+        tips_palm, joint_records, d = run(acts, lo, hi, held, source)
+    moved = np.linalg.norm(tips_palm - tips_palm[:, :1], axis=2).max(axis=1)
+    if (still := np.flatnonzero(moved < tol.FINGER_MOVED)).size:
+        i = int(still[0])
+        raise HandError(f"{source}: fingertip {spec.fingertips[i]!r} does not move when the actuators "
+                        f"({', '.join(m.actuator(a).name for a in acts)}) close (it moves "
+                        f"{1000 * moved[i]:.2f} mm, at least {1000 * tol.FINGER_MOVED:g} mm)")
+    roots = np.array([joint_records[i][0, 0] if len(c) else np.zeros(3) for i, c in enumerate(chains)])
+    axes = _hand_axes(tips_palm[:, 0] - roots if spec.approach is None else _axis(spec.approach, source)[None])
+    palm_geoms = _palm_geoms(m, d, palm, subtree, axes, collides)
+    knuckles = [float(joint_records[i][0, 0] @ axes[2]) for i, c in enumerate(chains) if len(c)]
+    depth = 0.0 if palm_geoms is None else min([float(palm_geoms[:, 2].max())] + knuckles)
+    shift = np.array([0.0, 0.0, depth])
+    tips_hand = tips_palm @ axes.T - shift
+    mount = Mount(palm=m.body(palm).name, rotation=tuple(map(tuple, axes.tolist())), position=tuple(-shift),
+                  actuators=tuple(m.actuator(a).name for a in acts), open_controls=tuple(lo.tolist()),
+                  closed_controls=tuple(hi.tolist()), held=tuple((m.actuator(a).name, v) for a, v in held),
+                  finger_bodies=_finger_bodies(m, palm, tips), tip_depth=float(tips_hand[:, :, 2].max()))
+    return ClosedModel(names=tuple(spec.names or spec.fingertips), times=m.opt.timestep * np.arange(tips_palm.shape[1]),
+                       tips=tips_hand, mount=mount,
+                       joints=tuple(np.transpose(j, (1, 0, 2)) @ axes.T - shift for j in joint_records),
+                       radius=np.array([_tip_radius(m, t, collides) for t in tips]),
+                       palm=None if palm_geoms is None else _palm_plate(palm_geoms - shift))
+
+
+def _finger_bodies(m, palm: int, tips) -> tuple[tuple[str, int], ...]:
+    """Each body below the palm that lies on a finger (toward its tip, or below such a body), with the finger."""
+    owner = {}
+    for i, tip in enumerate(tips):
+        body = _tip_body(m, tip)
+        while body != palm:
+            owner.setdefault(body, i)
+            body = int(m.body_parentid[body])
+    for b in range(palm + 1, m.nbody):  # depth first: a parent before its children
+        parent = int(m.body_parentid[b])
+        if b not in owner and parent in owner:
+            owner[b] = owner[parent]
+    return tuple((m.body(b).name, i) for b, i in sorted(owner.items()))
+
+
+def _spread(points: np.ndarray) -> float:
+    """Mean distance of the fingertips (n, 3) from their centroid."""
+    return float(np.linalg.norm(points - points.mean(axis=0), axis=1).mean())
+
+
+@dataclass(frozen=True, eq=False)
+class _Run:
+    """One closing of the model from fresh data: settle open, ramp the synergy, hold."""
+
+    m: mujoco.MjModel
+    palm: int
+    tips: list
+    chains: list
+    frozen: list
+    steps: tuple[int, int, int]
+
+    def __call__(self, acts, open_ctrl, closed_ctrl, held, source):
+        """Fingertips (n, k, 3) and per finger its hinge anchors (k, j, 3), palm frame, and the final data."""
+        m, d = self.m, mujoco.MjData(self.m)
+        settle, ramp, hold = self.steps
+        for a, value in held:
+            d.ctrl[a] = value
+        records, joint_records = [], []
+        with mujoco_warnings():
+            for k in range(settle + ramp + hold + 1):
+                u = min(1.0, max(0.0, (k - settle) / ramp))
+                d.ctrl[acts] = open_ctrl + u * (closed_ctrl - open_ctrl)
+                _freeze(m, d, self.frozen)
+                mujoco.mj_step(m, d) if k else mujoco.mj_forward(m, d)
+                if k >= settle:
+                    position, rotation = d.xpos[self.palm].copy(), d.xmat[self.palm].reshape(3, 3).copy()
+                    records.append([(_point(d, t) - position) @ rotation for t in self.tips])
+                    joint_records.append([(d.xanchor[c] - position) @ rotation for c in self.chains])
+        if d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number > 0 or not np.isfinite(np.asarray(records)).all():
+            raise SimulationError(f"{source}: the model is unstable while closing (NaN or huge accelerations)")
+        joints = [np.asarray([r[i] for r in joint_records]).reshape(len(records), len(c), 3)
+                  for i, c in enumerate(self.chains)]
+        return np.transpose(np.asarray(records), (1, 0, 2)), joints, d
+
+
+def _held(m, spec: ModelSpec, subtree: set[int], source: str) -> list[tuple[int, float]]:
+    """Actuators held still at a fraction of their control range (a pre-shape), as (id, control)."""
+    held = []
+    for name, fraction in spec.hold:
+        a = _actuators(m, (name,), subtree, source)[0]
+        lo, hi = m.actuator_ctrlrange[a]
+        held.append((int(a), float(lo + fraction * (hi - lo))))
+    return held
+
+
+def _palm_body(m, spec: ModelSpec, source: str) -> int:
+    if spec.palm is not None:
+        body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, spec.palm)
+        if body < 0:
+            kind = next((label for label, obj in (("a site", mujoco.mjtObj.mjOBJ_SITE), ("a geom", mujoco.mjtObj.mjOBJ_GEOM),
+                                                  ("a joint", mujoco.mjtObj.mjOBJ_JOINT))
+                         if mujoco.mj_name2id(m, obj, spec.palm) >= 0), "not a name in the model")
+            raise HandFileError(f"{source}: palm {spec.palm!r} is not a body ({kind})")
+        return body
+    paths = []
+    for name in spec.fingertips:
+        body = _fingertip_body(m, name, source)
+        path = [body]
+        while path[-1] != 0:
+            path.append(int(m.body_parentid[path[-1]]))
+        paths.append(path[::-1])
+    common = 0
+    for level in zip(*paths, strict=False):
+        if len(set(level)) != 1:
+            break
+        common = level[0]
+    if common == 0:
+        raise HandFileError(f"{source}: the fingertips share no body but the world; name the palm body (--palm)")
+    return common
+
+
+def _subtree(m, body: int) -> set[int]:
+    inside = {body}
+    for b in range(body + 1, m.nbody):  # MuJoCo numbers bodies depth first: children after parents
+        if int(m.body_parentid[b]) in inside:
+            inside.add(b)
+    return inside
+
+
+def _fingertip_body(m, name: str, source: str) -> int:
+    site = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, name)
+    if site >= 0:
+        return int(m.site_bodyid[site])
+    body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, name)
+    if body < 0:
+        raise HandFileError(f"{source}: fingertips: no site or body named {name!r} in the model")
+    return body
+
+
+def _fingertip(m, name: str, subtree: set[int], source: str) -> tuple[str, int]:
+    body = _fingertip_body(m, name, source)
+    if body not in subtree:
+        raise HandFileError(f"{source}: fingertips: {name!r} is not on a finger of the palm body")
+    site = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, name)
+    return ("site", site) if site >= 0 else ("body", body)
+
+
+def _point(d, tip: tuple[str, int]) -> np.ndarray:
+    kind, index = tip
+    return d.site_xpos[index].copy() if kind == "site" else d.xpos[index].copy()
+
+
+def _tip_body(m, tip: tuple[str, int]) -> int:
+    kind, index = tip
+    return int(m.site_bodyid[index]) if kind == "site" else index
+
+
+def _actuators(m, names, subtree: set[int], source: str) -> np.ndarray:
+    def on_hand(a: int) -> bool:
+        kind, target = int(m.actuator_trntype[a]), int(m.actuator_trnid[a, 0])
+        if kind in (mujoco.mjtTrn.mjTRN_JOINT, mujoco.mjtTrn.mjTRN_JOINTINPARENT):
+            return int(m.jnt_bodyid[target]) in subtree
+        return True  # tendons, sites, bodies: taken as the hand's
+
+    if names is None or list(names) == ["all"]:
+        chosen = [a for a in range(m.nu) if on_hand(a)]
+        if not chosen:
+            raise HandFileError(f"{source}: actuators: the model has no actuator on the palm's subtree")
+    else:
+        chosen = []
+        for name in names:
+            a = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
+            if a < 0:
+                known = ", ".join(m.actuator(i).name for i in range(m.nu)) or "none"
+                raise HandFileError(f"{source}: actuators: no actuator named {name!r} (the model's: {known})")
+            if not on_hand(a):
+                raise HandFileError(f"{source}: actuators: {name!r} drives a joint outside the palm's subtree")
+            chosen.append(a)
+    for a in chosen:
+        lo, hi = m.actuator_ctrlrange[a]
+        if not m.actuator_ctrllimited[a] or not lo < hi:
+            raise HandFileError(f"{source}: actuators: {m.actuator(a).name!r} has no control range (ctrlrange): "
+                                "the synergy drives each actuator from the low end of its range to the high end")
+    return np.array(chosen, dtype=int)
+
+
+def _freeze(m, d, joints) -> None:
+    """Hold the joints outside the palm's subtree at their reference position, at rest."""
+    for j in joints:
+        q, v = int(m.jnt_qposadr[j]), int(m.jnt_dofadr[j])
+        nq, nv = {mujoco.mjtJoint.mjJNT_FREE: (7, 6), mujoco.mjtJoint.mjJNT_BALL: (4, 3)}.get(int(m.jnt_type[j]), (1, 1))
+        d.qpos[q:q + nq] = m.qpos0[q:q + nq]
+        d.qvel[v:v + nv] = 0.0
+
+
+def _moving_path(m, tip: tuple[str, int], palm: int) -> list[int]:
+    """Hinge joints from the palm to the fingertip's body, palm side first."""
+    joints, body = [], _tip_body(m, tip)
+    while body != palm:
+        adr, count = int(m.body_jntadr[body]), int(m.body_jntnum[body])
+        joints = [j for j in range(adr, adr + count) if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE] + joints
+        body = int(m.body_parentid[body])
+    return joints
+
+
+def _axis(name: str, source: str) -> np.ndarray:
+    """The palm axis called ``name`` ("x", "-y", ...) as a unit 3-vector."""
+    axes = {f"{sign}{a}": (-1.0 if sign else 1.0) * np.eye(3)[i] for i, a in enumerate("xyz") for sign in ("", "-")}
+    if name not in axes:
+        raise HandFileError(f"{source}: approach must be one of {', '.join(axes)}, got {name!r}")
+    return axes[name]
+
+
+def _hand_axes(pointing: np.ndarray) -> np.ndarray:
+    """(3, 3) rows x, y, z of the hand frame in palm coordinates: z the signed palm axis nearest ``pointing``."""
+    mean = pointing.mean(axis=0)
+    k = int(np.argmax(np.abs(mean)))
+    z = np.zeros(3)
+    z[k] = np.sign(mean[k]) or 1.0
+    x = np.eye(3)[0 if k else 1]
+    return np.stack([x, np.cross(z, x), z])
+
+
+#: The eight corners of a unit box, for the geoms' local bounding boxes.
+_CORNERS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)
+
+
+def _local_corners(m, g: int) -> np.ndarray:
+    """(8, 3) float: the corners of geom ``g``'s bounding box in its own frame."""
+    return m.geom_aabb[g, :3] + _CORNERS * m.geom_aabb[g, 3:]
+
+
+def _geom_corners(m, d, geoms, origin: np.ndarray, rotation: np.ndarray) -> np.ndarray:
+    """(8 g, 3) float: the corners of each geom's local bounding box, in the frame (origin, rotation)."""
+    return np.concatenate([(_local_corners(m, g) @ d.geom_xmat[g].reshape(3, 3).T + d.geom_xpos[g] - origin) @ rotation
+                           for g in geoms])
+
+
+def _palm_geoms(m, d, palm: int, subtree: set[int], axes: np.ndarray, collides: np.ndarray) -> np.ndarray | None:
+    """Corners of the palm's own collision geoms (bodies welded to it), hand axes, palm origin; None if none."""
+    weld = int(m.body_weldid[palm])
+    geoms = [g for g in range(m.ngeom) if int(m.geom_bodyid[g]) in subtree
+             and int(m.body_weldid[m.geom_bodyid[g]]) == weld and collides[g]]
+    if not geoms:
+        return None
+    rotation = d.xmat[palm].reshape(3, 3)
+    return _geom_corners(m, d, geoms, d.xpos[palm], rotation) @ axes.T
+
+
+def _palm_plate(corners: np.ndarray) -> Palm:
+    (x0, y0, z0), (x1, y1, _) = corners.min(axis=0), corners.max(axis=0)
+    return Palm(outline=((x0, y0), (x1, y0), (x1, y1), (x0, y1)), thickness=max(float(-z0), tol.FINGER_MOVED))
+
+
+def _tip_radius(m, tip: tuple[str, int], collides: np.ndarray) -> float:
+    """Half the smallest extent of the fingertip body's collision geoms, in that body's frame; 0 without any."""
+    body = _tip_body(m, tip)
+    geoms = [g for g in range(m.ngeom) if int(m.geom_bodyid[g]) == body and collides[g]]
+    if not geoms:
+        return 0.0
+    corners = []
+    for g in geoms:
+        rotation = np.empty(9)
+        mujoco.mju_quat2Mat(rotation, m.geom_quat[g])
+        corners.append(_local_corners(m, g) @ rotation.reshape(3, 3).T + m.geom_pos[g])
+    points = np.concatenate(corners)
+    return float(np.ptp(points, axis=0).min() / 2)
+
+
+def fit_finger(name: str, path, *, radius: float = 0.0) -> tuple[Finger, FingerFit]:
+    """The finger whose trajectory fits a projected fingertip path: a ray, else an elliptic arc.
+
+    Parameters
+    ----------
+    name : str
+    path : (k, 2) float
+        The fingertip on the palm plane from open (first) to closed (last), hand frame, m.
+    radius : float
+        The finger's radius, m.
+
+    Returns
+    -------
+    Finger, FingerFit
+
+    Raises
+    ------
+    HandError
+        Neither fits within ``tolerances.MODEL_FIT_TOLERANCE`` (naming the finger and both errors).
+    """
+    path = np.asarray(path, dtype=float)
+    start, end = path[0], path[-1]
+    travel = float(np.linalg.norm(end - start))
+    if travel < tol.FINGER_MOVED:
+        raise HandError(f"finger {name!r}: its tip moves {1000 * travel:.2f} mm on the palm plane from open to closed "
+                        f"(at least {1000 * tol.FINGER_MOVED:g} mm)")
+    ray = Finger(name=name, start=tuple(start), trajectory=Ray(tuple((end - start) / travel)), travel=travel,
+                 alpha=ALPHA, beta=BETA, radius=radius)
+    ray_error = float(polyline_distance(path, [start, end]).max())
+    if ray_error <= tol.MODEL_FIT_TOLERANCE:
+        return ray, FingerFit(name, "ray", ray_error, ray_error)
+    arc, arc_error = _fit_arc(name, path, radius)
+    if arc is not None and arc_error <= tol.MODEL_FIT_TOLERANCE:
+        return arc, FingerFit(name, "arc", arc_error, ray_error)
+    arc_text = f"arc {1000 * arc_error:.2f} mm" if arc is not None else "no arc (the path turns clockwise or is no ellipse)"
+    raise HandError(f"finger {name!r}: no ray or arc fits its tip path on the palm plane within "
+                    f"{1000 * tol.MODEL_FIT_TOLERANCE:g} mm (ray {1000 * ray_error:.2f} mm, {arc_text})")
+
+
+def _fit_arc(name: str, path: np.ndarray, radius: float) -> tuple[Finger | None, float]:
+    """The arc (eq 3.20's axis-aligned ellipse) through a path: a least-squares conic, then the arc on it."""
+    mean = path.mean(axis=0)
+    scale = float(np.abs(path - mean).max())
+    x, y = ((path - mean) / scale).T
+    design = np.stack([x * x, y * y, x, y, np.ones_like(x)], axis=1)
+    a, b, c, e, f = np.linalg.svd(design)[2][-1]
+    if a * b <= 0:
+        return None, np.inf
+    cx, cy = -c / (2 * a), -e / (2 * b)
+    level = a * cx * cx + b * cy * cy - f
+    if level / a <= 0:
+        return None, np.inf
+    a_cos, a_sin = scale * np.sqrt(level / a), scale * np.sqrt(level / b)
+    centre = mean + scale * np.array([cx, cy])
+    angles = np.unwrap(np.arctan2((path[:, 1] - centre[1]) / a_sin, (path[:, 0] - centre[0]) / a_cos))
+    if angles[-1] <= angles[0] or max(a_cos, a_sin) > tol.MAX_HAND_SIZE:
+        return None, np.inf
+    try:
+        arc = Arc(float(a_cos), float(a_sin), float(angles[0]))
+        s, theta = arc._length_table
+        travel = float(np.interp(angles[-1] - angles[0], theta, s))
+        finger = Finger(name=name, start=tuple(path[0]), trajectory=arc, travel=travel, alpha=ALPHA, beta=BETA,
+                        radius=radius)
+    except HandError:
+        return None, np.inf
+    return finger, float(polyline_distance(path, finger.points(np.linspace(0.0, travel, tol.CHAIN_ARC_VERTICES))).max())
+
+
+def travelled(finger: Finger, path) -> np.ndarray:
+    """(k,) float: distance along the finger's trajectory of each path point's nearest trajectory point, m."""
+    lam = np.linspace(0.0, finger.travel, tol.CHAIN_ARC_VERTICES)
+    if isinstance(finger.trajectory, Ray):
+        return (np.asarray(path) - finger.start) @ np.asarray(finger.trajectory.closing_direction)
+    points = finger.points(lam)
+    nearest = np.linalg.norm(np.asarray(path)[:, None] - points[None], axis=2).argmin(axis=1)
+    return lam[nearest]
+
+
+def _with_virtual_starts(hand: Hand, closed: ClosedModel) -> Hand:
+    progress = np.array([travelled(f, closed.tips[i, :, :2]) for i, f in enumerate(hand.fingers)])
+    closing = Closing(names=closed.names, travel=np.array([f.travel for f in hand.fingers]), times=closed.times,
+                      travelled=progress)
+    starts = derive_virtual_starts(closing)
+    fingers = tuple(replace(f, virtual_start=round(starts[f.name], 4) + 0.0) for f in hand.fingers)
+    return replace(hand, fingers=fingers)
+
+
+def _with_chains(hand: Hand, closed: ClosedModel, ends: list[int]) -> tuple[Hand, tuple[str, ...]]:
+    if closed.palm is None:
+        return hand, ("the palm body has no collision geoms: no [palm], so no 3-D chains",)
+    chains, notes = [], []
+    for i, finger in enumerate(hand.fingers):
+        k = ends[i] + 1
+        chain, why = _chain(finger, closed.tips[i, :k], closed.joints[i][:, :k])
+        if chain is None:
+            notes.append(why)
+        chains.append(chain)
+    if notes:
+        return hand, tuple(notes)
+    return replace(hand, chains=tuple(chains), palm=closed.palm), ()
+
+
+def _chain(finger: Finger, tips: np.ndarray, joints: np.ndarray) -> tuple[FingerChain | None, str]:
+    """A two-link chain of a ray finger with two moving hinges, or None and why not."""
+    if not isinstance(finger.trajectory, Ray):
+        return None, f"finger {finger.name!r}: closes on an arc, which a planar chain cannot follow"
+    if len(joints) != 2:
+        return None, f"finger {finger.name!r}: {len(joints)} hinge joints between palm and tip; a chain has two"
+    knuckle, middle = joints
+    direction = np.asarray(finger.trajectory.closing_direction)
+    if knuckle[0, 2] < 0:
+        return None, f"finger {finger.name!r}: its first joint is {1000 * -knuckle[0, 2]:.1f} mm above the palm's underside"
+
+    def angle(a, b):  # absolute angles (open, closed) from +z, positive toward the closing direction
+        v = b[[0, -1]] - a[[0, -1]]
+        return np.arctan2(v[:, :2] @ direction, v[:, 2])
+
+    a1, a2 = angle(knuckle, middle), angle(middle, tips)
+    links = (float(np.linalg.norm(middle[0] - knuckle[0])), float(np.linalg.norm(tips[0] - middle[0])))
+    try:
+        chain = FingerChain(knuckle=tuple(knuckle[0, :2]), knuckle_depth=float(knuckle[0, 2]), direction=tuple(direction),
+                            links=links, radius=finger.radius, open_angles=(float(a1[0]), float(a2[0] - a1[0])),
+                            closed_angles=(float(a1[1]), float(a2[1] - a1[1])))
+        check_chain(finger, chain)
+    except HandError as err:
+        return None, str(err)
+    return chain, ""
+
+
+def fit_table(derivation: Derivation) -> list[str]:
+    """Lines of a plain-text table: per finger its trajectory, start, travel, virtual start and fit error."""
+    lines = [f"{'finger':8s} {'fit':4s} {'start x, y mm':>16s} {'travel mm':>10s} {'lambda_virt mm':>15s} "
+             f"{'fit error mm':>13s} {'ray error mm':>13s}"]
+    for f, fit in zip(derivation.hand.fingers, derivation.fits, strict=True):
+        start = f"{1000 * f.start[0]:.1f}, {1000 * f.start[1]:.1f}"
+        lines.append(f"{f.name:8s} {fit.kind:4s} {start:>16s} {1000 * f.travel:10.1f} {1000 * f.virtual_start:+15.1f} "
+                     f"{1000 * fit.error:13.2f} {1000 * fit.ray_error:13.2f}")
+    lines.append("3-D chains and palm: " + ("yes" if derivation.hand.is_3d else "no (" + "; ".join(derivation.notes) + ")"))
+    return lines

@@ -1,0 +1,115 @@
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from contourgrasp import tolerances as tol
+from contourgrasp.errors import HandError, HandFileError
+from contourgrasp.hand import Arc, Ray
+from contourgrasp.io.hand_file import hand_to_toml, load_hand, parse_hand
+from contourgrasp.sim.hand_model import build_hand
+from contourgrasp.sim.model_hand import MODELS, derive_hand, fit_finger
+
+#: Two fingers sliding straight in the palm plane: known rays (see the file).
+TWO_SLIDERS = Path(__file__).parent / "fixtures" / "two-sliders.xml"
+
+
+@pytest.fixture
+def sliders():
+    return TWO_SLIDERS
+
+
+def own_hand_xml(tmp_path, preset="five-finger-linear"):
+    """The MJCF of the simulated hand built from a preset, on its floating base (which the palm fixes)."""
+    model = build_hand(load_hand(preset))
+    path = tmp_path / f"{preset}.xml"
+    path.write_text(f"""<mujoco><compiler angle="radian" autolimits="true"/>
+<option timestep="0.002" integrator="implicitfast"/>
+<worldbody>{model.body_xml()}</worldbody><tendon>{model.tendon_xml()}</tendon>
+<actuator>{model.actuator_xml()}</actuator></mujoco>""")
+    return path, model
+
+
+def test_known_straight_slides_give_exactly_those_rays(sliders):
+    derived = derive_hand(sliders, fingertips=["left_tip", "right_tip"])
+    left, right = derived.hand.fingers
+    np.testing.assert_allclose(left.start, [-0.05, 0.01], atol=1e-6)
+    np.testing.assert_allclose(left.trajectory.closing_direction, [1.0, 0.0], atol=1e-6)
+    assert left.travel == pytest.approx(0.04, abs=1e-6)
+    np.testing.assert_allclose(right.start, [0.06, -0.02], atol=1e-6)
+    np.testing.assert_allclose(right.trajectory.closing_direction, [-np.sqrt(0.5), np.sqrt(0.5)], atol=1e-6)
+    assert right.travel == pytest.approx(0.03, abs=1e-6)
+    assert [f.kind for f in derived.fits] == ["ray", "ray"] and max(f.error for f in derived.fits) < 1e-6
+    assert left.radius == pytest.approx(0.008) and right.radius == pytest.approx(0.006)
+    assert not derived.hand.is_3d and "hinge" in derived.notes[0]  # slides are no two-link chains
+
+
+def test_own_simulated_hand_reproduces_the_preset_within_a_millimetre(tmp_path):
+    path, model = own_hand_xml(tmp_path)
+    preset = load_hand("five-finger-linear")
+    derived = derive_hand(path, fingertips=[f"{f.name}_tip" for f in model.fingers], actuators=["flexion"],
+                          palm="palm")
+    assert derived.hand.is_3d
+    for want, got, fit in zip(preset.fingers, derived.hand.fingers, derived.fits, strict=True):
+        assert isinstance(got.trajectory, Ray) and fit.error < 1e-3
+        assert np.linalg.norm(np.subtract(want.start, got.start)) < 1e-3
+        assert np.linalg.norm(want.end - got.end) < 1e-3
+        assert got.radius == pytest.approx(want.radius)
+    for want, got in zip(preset.chains, derived.hand.chains, strict=True):
+        np.testing.assert_allclose(got.knuckle, want.knuckle, atol=1e-6)
+        np.testing.assert_allclose(got.links, want.links, atol=1e-6)
+        np.testing.assert_allclose(got.open_angles, want.open_angles, atol=1e-3)
+    # the thesis timing: the thumb closes first and fastest (lambda_virt about +34 mm, see calibrate)
+    thumb = derived.hand.fingers[0]
+    assert thumb.virtual_start > 0.02 and all(abs(f.virtual_start) < 0.01 for f in derived.hand.fingers[1:])
+    assert parse_hand(hand_to_toml(derived.hand)) == derived.hand
+
+
+def test_the_approach_axis_decides_the_palm_plane(sliders):
+    # approaching along the palm's x, the left finger slides along the approach: it does not close
+    with pytest.raises(HandError, match="finger 'left_tip': its tip moves 0.00 mm on the palm plane"):
+        derive_hand(sliders, fingertips=["left_tip", "right_tip"], approach="x")
+    flipped = derive_hand(sliders, fingertips=["left_tip", "right_tip"], approach="-z").hand.fingers[0]
+    np.testing.assert_allclose(flipped.start, [-0.05, -0.01], atol=1e-6)  # x kept, y = z x x turned over
+    with pytest.raises(HandFileError, match="approach must be one of x, -x"):
+        derive_hand(sliders, fingertips=["left_tip", "right_tip"], approach="up")
+
+
+def test_fit_finger_recovers_an_arc_and_refuses_a_zigzag():
+    truth = Arc(0.05, 0.03, 3.5)
+    lam = np.linspace(0.0, 0.06, 300)
+    path = np.array([0.1, 0.2]) + truth.offset(lam)
+    finger, fit = fit_finger("curl", path)
+    assert fit.kind == "arc" and fit.error < 1e-6 and fit.ray_error > tol.MODEL_FIT_TOLERANCE
+    assert finger.travel == pytest.approx(0.06, abs=1e-5)
+    zigzag = np.stack([np.linspace(0, 0.05, 50), 0.01 * np.sign(np.sin(np.linspace(0, 20, 50)))], axis=1)
+    with pytest.raises(HandError, match="finger 'zig': no ray or arc fits"):
+        fit_finger("zig", zigzag)
+
+
+@pytest.mark.parametrize("name, fingers", [("inspire", 5), ("jaco-three-finger", 3)])
+def test_bundled_models_derive_hands_within_the_tolerance(name, fingers):
+    derived = derive_hand(name)
+    assert len(derived.hand.fingers) == fingers and derived.hand.name == name
+    assert all(f.error <= tol.MODEL_FIT_TOLERANCE for f in derived.fits)
+    ends = derived.hand.ends
+    assert np.linalg.norm(ends - ends.mean(axis=0), axis=1).mean() < np.linalg.norm(
+        derived.hand.starts - derived.hand.starts.mean(axis=0), axis=1).mean()  # closing brings the tips together
+
+
+def test_bad_models_are_refused_naming_what(sliders, tmp_path):
+    with pytest.raises(HandFileError, match="no site or body named 'nose'"):
+        derive_hand(sliders, fingertips=["left_tip", "nose"])
+    with pytest.raises(HandError, match="fingertip 'right_tip' does not move"):
+        derive_hand(sliders, fingertips=["left_tip", "right_tip"], actuators=["left_drive"])
+    with pytest.raises(HandFileError, match="palm 'left_tip' is not a body \\(a site\\)"):
+        derive_hand(sliders, fingertips=["left_tip", "right_tip"], palm="left_tip")
+    with pytest.raises(HandFileError, match="no actuator named 'grip'"):
+        derive_hand(sliders, fingertips=["left_tip"], actuators=["grip"])
+    broken = tmp_path / "broken.xml"
+    broken.write_bytes(b"\x00\xffnot xml")
+    with pytest.raises(HandFileError, match="broken.xml: cannot load the MuJoCo model"):
+        derive_hand(broken, fingertips=["tip"])
+    with pytest.raises(HandFileError, match="name the fingertips"):
+        derive_hand(sliders)
+    assert set(MODELS) == {"inspire", "jaco-three-finger"}

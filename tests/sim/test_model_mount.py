@@ -1,0 +1,41 @@
+import numpy as np
+import pytest
+
+from contourgrasp.sim.model_hand import MODELS
+from contourgrasp.sim.model_mount import PREFIX, mount_model
+from contourgrasp.sim.planners import make_planner
+from contourgrasp.sim.scene import build_scene
+from contourgrasp.sim.trial import run_trial
+
+
+@pytest.fixture(scope="module")
+def jaco():
+    return mount_model("jaco-three-finger")
+
+
+def tips_in_hand_frame(scene, name):
+    position, rotation = scene.palm_pose()
+    sites = [scene.model.site(PREFIX + tip).id for tip in MODELS[name].fingertips]
+    return (scene.data.site_xpos[sites] - position) @ rotation
+
+
+@pytest.mark.parametrize("name", ["jaco-three-finger", "inspire"])
+def test_mounted_model_opens_and_closes_on_its_derived_hand(name):
+    mounted = mount_model(name)
+    scene = build_scene("can", seed=0, hand=mounted)
+    scene.set_hand(0.0, 0.0, 0.6, 0.0)
+    scene.step(2.0)  # as the derivation, which settles the open hand for 2 s
+    hand = mounted.hand
+    np.testing.assert_allclose(tips_in_hand_frame(scene, name)[:, :2], hand.starts, atol=1e-3)
+    nearest = np.full(len(hand.fingers), np.inf)
+    for k in range(1, 751):  # the trials' closing: the synergy ramped over 1 s, then held
+        scene.command([0.0, 0.0, 0.6, 0.0], min(1.0, k / 500))
+        scene.step()
+        nearest = np.minimum(nearest, np.linalg.norm(tips_in_hand_frame(scene, name)[:, :2] - hand.ends, axis=1))
+    assert nearest.max() < 1e-3  # every fingertip passes through its derived closed position
+    assert set(mounted.geom_names()) <= {scene.model.geom(g).name for g in range(scene.model.ngeom)}
+
+
+def test_a_trial_with_the_mounted_jaco_grasps_the_can(jaco):
+    record = run_trial("can", seed=0, planner=make_planner("default", jaco.hand, seed=0), hand=jaco)
+    assert record.cause is None and set(record.fingers_in_contact) == {"thumb", "index", "pinky"}
