@@ -194,7 +194,7 @@ def plan_frame(
         The small-object rule: when no pose satisfies the constraints with the hand's
         ``min_touching`` fingers, plan again with fewer touching fingers, down to
         ``tolerances.SMALL_OBJECT_TOUCHING`` (the thumb, or the hand's required fingers, against
-        two others): a one-DoF power grasp of a small object closes the whole hand, but only the
+        one other): a one-DoF power grasp of a small object closes the whole hand, but only the
         thumb and the fingers opposite it reach the object. The plan's ``hand`` has the
         ``min_touching`` it was planned with, and its notes say so.
     **synthesis_options
