@@ -241,6 +241,9 @@ def _add_bench_parser(sub) -> None:
                             "(pip install 'contourgrasp[cluster]')")
     bench.add_argument("--resume", metavar="DIR",
                        help="continue the bench whose outputs are in DIR (same settings), keeping its trials")
+    bench.add_argument("--scene", choices=("single", "clutter", "bin"), default="single",
+                       help="one object on the table (default), 2-4 on the table, or 1-3 in a bin: each object "
+                            "in turn the target among the others of its set (see README, 'Clutter and bin scenes')")
 
 
 def _add_calibrate_parser(sub) -> None:
@@ -411,7 +414,7 @@ def _bench(args) -> int:
 
         planners += [p.name for p in ablation_planners()[1:-1] if p.name not in planners]
     setup = bench.Bench(objects=objects, planners=planners, trials=args.trials, seed=args.seed,
-                        hand=load_hand(args.hand), noise=args.noise, splits=splits)
+                        hand=load_hand(args.hand), noise=args.noise, splits=splits, scene_kind=args.scene)
     journal, done = bench.resume(out, setup) if args.resume is not None else (None, ())
     with bench.executor(setup, workers=args.workers, ray=args.ray is not None, address=args.ray or None) as run:
         if journal is None:

@@ -313,3 +313,8 @@ MAX_PLAUSIBLE_DEPTH = 20.0
 
 #: A median depth below this (m) is closer than any depth camera measures.
 MIN_PLAUSIBLE_DEPTH = 0.02
+
+# --- simulated scenes of several objects (issue 17) ---
+
+#: A neighbour whose centre of mass rose more than this (m) during a grasp was lifted with the target.
+NEIGHBOUR_LIFT = 0.02
