@@ -8,10 +8,11 @@ from contourgrasp import load_hand
 from contourgrasp.errors import SimulationError
 from contourgrasp.hand import to_image
 from contourgrasp.sim import (BIN_LABEL, HIT, Bin, ObjectSpec, Part, arrange, build_clutter, execute_grasp,
-                              hand_pose_from_matrix, object_spec, render, run_trial, scripted_grasp, target_pixel,
-                              truth_labels)
+                              hand_pose_from_matrix, object_spec, pose_matrix, render, run_trial, scripted_grasp,
+                              target_pixel, truth_labels)
 from contourgrasp.sim.clutter import MAX_TILT, OBJECT_COUNTS, overlap, plan_hull
 from contourgrasp.sim.planners import make_planner
+from contourgrasp.sim.scene import R_WORLD_CAMERA
 
 SETTLE = 0.2
 #: A light 24 x 24 x 6 mm tile, to rest on top of a target.
@@ -176,3 +177,16 @@ def test_a_scene_of_several_objects_needs_neighbours():
         arrange("clutter", object_spec("can"), [], seed=0)
     with pytest.raises(SimulationError, match="scene kind"):
         arrange("heap", object_spec("can"), ["can"], seed=0)
+
+
+def test_a_pose_planned_in_the_tilted_view_is_executed_where_it_was_planned():
+    scene = build_clutter("can", ["stone2"], kind="clutter", seed=0, settle=0.01)
+    eye, R_world_view = scene.view
+    assert np.degrees(np.arccos(-R_world_view[2, 2])) > 5  # this seed tilts the camera
+    x, y, yaw, depth = 0.03, -0.02, 0.7, 0.55
+    T_world_reference = np.eye(4)
+    T_world_reference[:3, :3], T_world_reference[:3, 3] = R_WORLD_CAMERA, scene.camera.position
+    T_world_view = np.eye(4)
+    T_world_view[:3, :3], T_world_view[:3, 3] = R_world_view, eye
+    T_view_hand = np.linalg.inv(T_world_view) @ T_world_reference @ pose_matrix(x, y, yaw, depth)
+    np.testing.assert_allclose(scene.to_reference(T_view_hand), (x, y, yaw, depth), atol=1e-12)
