@@ -12,11 +12,18 @@ The object is placed with its resting face down at a random position inside
 :class:`Workspace` and a random yaw (both from the seed), then left to settle
 for :data:`SETTLE_TIME` before anything looks at it.
 
+A scene may also hold neighbours (bodies ``neighbour_0``, ...) and a
+:class:`Bin`, whose floor's top is then the plane z = 0 and the table that much
+lower; :mod:`contourgrasp.sim.clutter` arranges and builds such scenes, and
+:attr:`Scene.view` is their tilted camera.
+
 Contacts
 --------
 Object contacts are explicit pairs with the object's own frictions (glove and
-table, see :mod:`contourgrasp.sim.objects`); hand geoms collide with the table
-by their contact bits and never with each other. Solver settings follow what
+table, see :mod:`contourgrasp.sim.objects`; object on object, the mean of their
+table frictions; the bin's floor as the table, its walls without rolling
+friction); hand geoms collide with the table and the bin by their contact bits
+and never with each other. Solver settings follow what
 makes grasps hold in MuJoCo: elliptic friction cones, ``impratio`` 10, the
 ``implicitfast`` integrator, a 2 ms step.
 """
