@@ -324,15 +324,16 @@ class _Probe:
             finger = next((i for i, f in enumerate(scene.hand.fingers) if name.startswith(f"{f.name}_")
                            and not name.endswith("_post")), -1)
             self.finger_of[model.geom(name).id] = finger
+        self.hand_geoms = np.fromiter(self.finger_of, dtype=int)
 
     def touching(self) -> set[int]:
-        """Finger indices (-1 for palm or post) in contact with the object now."""
+        """Finger indices (-1 for palm or post) in contact with the object now (and :attr:`hit` updated)."""
         data = self.scene.data
         if data.ncon == 0:
             return set()
         pairs = data.contact.geom[: data.ncon]
         if len(self.obstacle_geoms) and not self.hit:
-            hand = np.isin(pairs, list(self.finger_of))
+            hand = np.isin(pairs, self.hand_geoms)
             obstacle = np.isin(pairs, self.obstacle_geoms)
             self.hit = bool(np.any((hand[:, 0] & obstacle[:, 1]) | (hand[:, 1] & obstacle[:, 0])))
         found = set()
