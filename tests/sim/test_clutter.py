@@ -190,3 +190,14 @@ def test_a_pose_planned_in_the_tilted_view_is_executed_where_it_was_planned():
     T_world_view[:3, :3], T_world_view[:3, 3] = R_world_view, eye
     T_view_hand = np.linalg.inv(T_world_view) @ T_world_reference @ pose_matrix(x, y, yaw, depth)
     np.testing.assert_allclose(scene.to_reference(T_view_hand), (x, y, yaw, depth), atol=1e-12)
+
+
+@pytest.mark.parametrize("kind", ["clutter", "bin"])
+def test_the_target_is_wholly_in_view_and_its_pixel_on_it(kind):
+    for seed in range(3):
+        scene = build_clutter("bottle", ["case", "stone1"], kind=kind, seed=seed, settle=0.01)
+        target = truth_labels(scene) == 1
+        assert target.sum() > 1000 and not (target[0].any() or target[-1].any() or target[:, 0].any()
+                                            or target[:, -1].any())
+        u, v = target_pixel(scene)
+        assert target[v, u]
