@@ -26,9 +26,25 @@ footprint (the pixels that see the table where the object stands). ``auto``
 aims at the first from a top-down camera and at the second from a tilted one
 (its mean is in bold). This table needs no shared data.
 
+A third table scores the scenes of several objects of the bench
+(:mod:`contourgrasp.sim.clutter`: ``clutter``, 2-4 YCB objects on the table,
+and ``bin``, 1-3 in a bin; the bench's SR300 camera, tilted 0-25 deg by the
+seed, its depth noise), ``--scene-seeds`` scenes per kind and YCB split, the
+target the seed's object of the split and its neighbours the split's others,
+as in ``contourgrasp bench --scene``. Per kind and split: the target's IoU
+when perception is given the target's pixel (:func:`contourgrasp.sim.target_pixel`,
+as the bench gives it) against the exact footprint (camera tilted more than
+2 deg) or the exact region seen (:func:`contourgrasp.sim.object_truth`, what
+``auto`` aims at), a refused frame scoring 0; and the candidates
+(:func:`contourgrasp.perception.find_candidates` on the fitted table plane)
+against the objects present (:func:`contourgrasp.sim.truth_labels`, those
+seen by at least ``MIN_AREA_PX`` pixels): how many were found, and how many
+objects one candidate matches to IoU >= 0.5 (the bin's walls are a candidate
+of their own, matching no object).
+
 Usage::
 
-    python benchmarks/segmentation.py [--data PATH] [--repeat N] [--sim-seeds N]
+    python benchmarks/segmentation.py [--data PATH] [--repeat N] [--sim-seeds N] [--scene-seeds N]
 
 ``--data`` defaults to ``$CONTOURGRASP_SHARED_DATA`` or ``../shared/data``
 beside the repository.
@@ -46,10 +62,14 @@ from pathlib import Path
 
 import numpy as np
 
+from contourgrasp import perception, pipeline
+from contourgrasp.errors import InputError
 from contourgrasp.io.camera_file import read_intrinsics, read_mask, read_rgb
 from contourgrasp.perception import SegmentationError, register_colour, segment
-from contourgrasp.sim import Camera, Intrinsics, build_scene, object_truth, render, tilted_view
+from contourgrasp.sim import (Camera, Intrinsics, build_clutter, build_scene, object_truth, render, target_pixel,
+                              tilted_view, truth_labels)
 from contourgrasp.sim.objects import flat_tool
+from contourgrasp.tolerances import MIN_AREA_PX
 
 #: Targets for the default method (from the perception issue).
 TARGET_MEAN, TARGET_WORST = 0.90, 0.75
@@ -153,11 +173,71 @@ def print_simulated(seeds) -> None:
     print("\n".join(notes))
 
 
+#: The scenes of several objects scored: kinds and the YCB splits their objects come from.
+SCENE_KINDS, SCENE_SPLITS = ("clutter", "bin"), ("ycb-train", "ycb-test")
+#: A candidate finds an object when their IoU is at least this.
+MATCH_IOU = 0.5
+
+
+def rendered_scenes(seeds):
+    """Per (kind, split), one row per scene: target IoU (0 when refused), refused, objects present,
+    candidates found, objects matched by a candidate."""
+    from contourgrasp.sim.ycb import OBJECT_SETS, load_object
+
+    rows = {}
+    for split in SCENE_SPLITS:
+        objects = [load_object(f"ycb:{name}") for name in OBJECT_SETS[split]]
+        for kind in SCENE_KINDS:
+            for seed in range(seeds):
+                target = objects[seed % len(objects)]
+                scene = build_clutter(target, [o for o in objects if o is not target], kind=kind, seed=seed)
+                rows.setdefault((kind, split), []).append(_score_scene(scene, seed))
+    return rows
+
+
+def _score_scene(scene, seed):
+    rgb, depth = render(scene, noise=True, seed=seed)
+    intr = scene.camera.intrinsics
+    labels = truth_labels(scene)
+    seen, footprint = object_truth(scene)
+    tilted = np.arccos(-scene.view[1][2, 2]) > np.radians(2.0)  # tolerances.TILT_PLANE_THRESHOLD
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            segmentation = pipeline.perceive(rgb, depth, intr, target_px=target_pixel(scene))[0]
+            target_iou, refused = iou(segmentation.mask, footprint if tilted else seen), 0
+        except InputError:
+            target_iou, refused = 0.0, 1
+        filled, _ = perception.fill_depth_holes(perception.as_depth(depth))
+        try:
+            candidates = perception.find_candidates(filled, intr, perception.fit_table_plane(filled, intr))
+        except SegmentationError:
+            candidates = ()
+    present = [labels == k for k in range(1, len(scene.neighbours) + 2) if (labels == k).sum() >= MIN_AREA_PX]
+    matched = sum(any(iou(c.mask, obj) >= MATCH_IOU for c in candidates) for obj in present)
+    return target_iou, refused, len(present), len(candidates), matched
+
+
+def print_rendered_scenes(seeds) -> None:
+    rows = rendered_scenes(seeds)
+    print(f"\nScenes of several objects ({seeds} per kind and split, the bench's camera tilted 0-25 deg, its depth "
+          f"noise): the target given by its pixel, candidates against the objects present\n")
+    print("| scene | split | target IoU, mean (worst) | refused | objects present | candidates found | "
+          f"objects found (IoU >= {MATCH_IOU}) |")
+    print("|---|---|---:|---:|---:|---:|---:|")
+    for (kind, split), scores in rows.items():
+        a = np.array(scores)
+        print(f"| {kind} | {split} | {a[:, 0].mean():.3f} ({a[:, 0].min():.3f}) | {int(a[:, 1].sum())} | "
+              f"{int(a[:, 2].sum())} | {int(a[:, 3].sum())} | {int(a[:, 4].sum())} |")
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--data", type=Path, default=default_data(), help="shared data folder")
     parser.add_argument("--repeat", type=int, default=3, help="runs per frame; the best time is kept")
     parser.add_argument("--sim-seeds", type=int, default=3, help="placements per simulated object (0: none)")
+    parser.add_argument("--scene-seeds", type=int, default=5,
+                        help="scenes of several objects per kind and YCB split (0: none)")
     args = parser.parse_args(argv)
     rows = list(frames(args.data))
     if rows:
@@ -167,6 +247,8 @@ def main(argv=None) -> int:
         print(f"no frames with segmask_N.png found under {args.data}/rgbd: real frames skipped", file=sys.stderr)
     if args.sim_seeds > 0:
         print_simulated(args.sim_seeds)
+    if args.scene_seeds > 0:
+        print_rendered_scenes(args.scene_seeds)
     return 0
 
 

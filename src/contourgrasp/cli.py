@@ -257,6 +257,9 @@ def _add_bench_parser(sub) -> None:
     bench.add_argument("--actuators", nargs="+", metavar="NAME", help="with --hand-model: see hand-from-model")
     bench.add_argument("--palm", metavar="BODY", help="with --hand-model: see hand-from-model")
     bench.add_argument("--approach", choices=APPROACHES, help="with --hand-model: see hand-from-model")
+    bench.add_argument("--scene", choices=("single", "clutter", "bin"), default="single",
+                       help="one object on the table (default), 2-4 on the table, or 1-3 in a bin: each object "
+                            "in turn the target among the others of its set (see README, 'Clutter and bin scenes')")
 
 
 def _add_calibrate_parser(sub) -> None:
@@ -497,7 +500,8 @@ def _bench(args) -> int:
     mounted = _hand_model(args)
     hand = load_hand(args.hand or "five-finger-linear") if mounted is None else mounted.hand
     setup = bench.Bench(objects=objects, planners=planners, trials=args.trials, seed=args.seed, hand=hand,
-                        noise=args.noise, splits=splits, hand_model=mounted)
+                        noise=args.noise, splits=splits, hand_model=mounted,
+                        scene_kind=args.scene)
     journal, done = bench.resume(out, setup) if args.resume is not None else (None, ())
     with bench.executor(setup, workers=args.workers, ray=args.ray is not None, address=args.ray or None) as run:
         if journal is None:

@@ -314,6 +314,7 @@ def perceive(
     fill_holes: bool = True,
     colour_offset_px=None,
     approach_offset: float = APPROACH_OFFSET,
+    target_px=None,
 ) -> tuple[Segmentation, MetricContour, int]:
     """The perception half of :func:`plan_frame`: (segmentation, metric contour, filled depth pixels).
 
@@ -321,7 +322,8 @@ def perceive(
     the contour in meters; the options are :func:`plan_frame`'s.
     """
     return _perceive(rgb, depth, intrinsics, segment=segment, mask=mask, depth_mode=depth_mode, footprint=footprint,
-                     fill_holes=fill_holes, colour_offset_px=colour_offset_px, approach_offset=approach_offset)[:3]
+                     fill_holes=fill_holes, colour_offset_px=colour_offset_px, approach_offset=approach_offset,
+                     target_px=target_px)[:3]
 
 
 def _perceive(rgb, depth, intrinsics, *, segment, mask, depth_mode, footprint, fill_holes, colour_offset_px,

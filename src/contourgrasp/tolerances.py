@@ -377,3 +377,7 @@ VERTICAL_AXIS = 1e-12
 #: Largest distance (m) of a MuJoCo model's fingertip path, projected on the palm plane, from the ray or
 #: elliptic arc fitted to it; a finger fitting neither within this is refused by hand-from-model.
 MODEL_FIT_TOLERANCE = 3e-3
+# --- simulated scenes of several objects (issue 17) ---
+
+#: A neighbour whose centre of mass rose more than this (m) during a grasp was lifted with the target.
+NEIGHBOUR_LIFT = 0.02

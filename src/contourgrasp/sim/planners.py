@@ -1,10 +1,13 @@
 """Planners for simulated trials: the library's pipeline under named settings, and two baselines.
 
 A planner is what :func:`~contourgrasp.sim.trial.run_trial` calls:
-``planner(rgb, depth, intrinsics) -> (T_camera_hand, approach_depth)``, raising
-:class:`~contourgrasp.errors.NoFeasibleGrasp` or
-:class:`~contourgrasp.errors.InputError` when it has no plan. Every planner
-here also has ``plan(rgb, depth, intrinsics) -> PlannedGrasp``, the same
+``planner(rgb, depth, intrinsics, *, target_px=None) -> (T_camera_hand, approach_depth)``,
+raising :class:`~contourgrasp.errors.NoFeasibleGrasp` or
+:class:`~contourgrasp.errors.InputError` when it has no plan; ``target_px``,
+given in a scene of several objects, is the pixel (u, v) on the object to
+grasp, and every planner here plans on the object under it (the baselines too,
+through the same perception). Every planner here also has
+``plan(rgb, depth, intrinsics, *, target_px=None) -> PlannedGrasp``, the same
 answer with what it saw (for figures).
 
 Synthesis planners (:func:`synthesis_planner`)
@@ -113,8 +116,8 @@ class _Planner:
 
     hand: Hand
 
-    def __call__(self, rgb, depth, intrinsics):
-        planned = self.plan(rgb, depth, intrinsics)
+    def __call__(self, rgb, depth, intrinsics, *, target_px=None):
+        planned = self.plan(rgb, depth, intrinsics, target_px=target_px)
         return planned.T_camera_hand, planned.approach_depth, planned.grasp_height
 
 
@@ -124,8 +127,8 @@ class SynthesisPlanner(_Planner):
 
     options: tuple[tuple[str, object], ...] = ()
 
-    def plan(self, rgb, depth, intrinsics) -> PlannedGrasp:
-        result = pipeline.plan_frame(rgb, depth, intrinsics, self.hand, **dict(self.options))
+    def plan(self, rgb, depth, intrinsics, *, target_px=None) -> PlannedGrasp:
+        result = pipeline.plan_frame(rgb, depth, intrinsics, self.hand, target_px=target_px, **dict(self.options))
         return PlannedGrasp(result.plan.pose, result.T_camera_hand, result.metric.approach_depth,
                             result.segmentation, result.metric, result.camera, result.plan, result.grasp_height)
 
@@ -134,8 +137,8 @@ class SynthesisPlanner(_Planner):
 class CentroidPlanner(_Planner):
     """The ``centroid-principal-axis`` baseline (module docstring)."""
 
-    def plan(self, rgb, depth, intrinsics) -> PlannedGrasp:
-        segmentation, metric, _ = pipeline.perceive(rgb, depth, intrinsics)
+    def plan(self, rgb, depth, intrinsics, *, target_px=None) -> PlannedGrasp:
+        segmentation, metric, _ = pipeline.perceive(rgb, depth, intrinsics, target_px=target_px)
         return _planned(centroid_pose(metric.contour_xy, self.hand), segmentation, metric, intrinsics)
 
 
@@ -145,8 +148,8 @@ class RandomPlanner(_Planner):
 
     seed: int = 0
 
-    def plan(self, rgb, depth, intrinsics) -> PlannedGrasp:
-        segmentation, metric, _ = pipeline.perceive(rgb, depth, intrinsics)
+    def plan(self, rgb, depth, intrinsics, *, target_px=None) -> PlannedGrasp:
+        segmentation, metric, _ = pipeline.perceive(rgb, depth, intrinsics, target_px=target_px)
         rng = np.random.default_rng([self.seed, 2])  # streams 0 and 1 place the object and add noise
         pose = random_feasible_pose(metric.contour_xy, self.hand, rng, search_settings(RANDOM_REGION))
         return _planned(pose, segmentation, metric, intrinsics)

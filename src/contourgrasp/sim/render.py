@@ -13,7 +13,8 @@ sensor's range.
 
 :func:`object_truth` gives the exact segmentation of a picture, for judging
 perception against it: the pixels that see the object, and the pixels that see
-the table where the object stands (its footprint). :func:`tilted_view` places
+the table where the object stands (its footprint); :func:`truth_labels` which
+object of a scene of several every pixel sees (the geom its ray meets first). :func:`tilted_view` places
 a camera that is not top-down, like the PrimeSense of the shared real frames.
 """
 
@@ -33,6 +34,8 @@ SCENE_GROUPS = (0, 1)
 VIEW_INTRINSICS = Intrinsics(fx=300.0, fy=300.0, cx=159.5, cy=119.5, width=320, height=240)
 #: Farthest hit :func:`render_view` looks for, m.
 VIEW_RANGE = 5.0
+#: The label of the bin in :func:`truth_labels`.
+BIN_LABEL = -1
 #: :func:`object_truth` looks for the object this far (m) beyond its collision parts' extent.
 TRUTH_MARGIN = 0.05
 
@@ -71,7 +74,8 @@ def render(scene: Scene, *, noise: DepthNoise | bool = False, seed: int = 0,
         Draw the hand too (for figures; the planner's picture is taken without it).
     view : (eye, R_world_camera), optional
         The optical centre (3,) and the optical frame's rotation (3, 3), world
-        frame (e.g. from :func:`tilted_view`); default: the scene's top-down camera.
+        frame (e.g. from :func:`tilted_view`); default: the scene's :attr:`~Scene.view`
+        if it has one (a tilted camera of :mod:`~contourgrasp.sim.clutter`), else its top-down camera.
 
     Returns
     -------
@@ -170,6 +174,25 @@ def object_truth(scene: Scene, view=None) -> tuple[np.ndarray, np.ndarray]:
     return seen, footprint.reshape(seen.shape)
 
 
+def truth_labels(scene: Scene, view=None) -> np.ndarray:
+    """(H, W) int: which object each pixel of :func:`render`'s picture (same ``view``) sees, hand never shown.
+
+    0 the table, the bin's floor (or nothing), ``1`` the target (body ``object``), ``k + 2`` the
+    neighbour ``k``, :data:`BIN_LABEL` the bin's walls. Exact: the geom each pixel's ray meets first.
+    """
+    eye, R_world_camera = _view(scene, view)
+    _, _, geom = _cast(scene, eye, R_world_camera, scene.camera.intrinsics, False, VIEW_RANGE)
+    model = scene.model
+    body_label = np.zeros(model.nbody, dtype=int)
+    body_label[model.body("object").id] = 1
+    for k in range(len(scene.neighbours)):
+        body_label[model.body(f"neighbour_{k}").id] = k + 2
+    geom_label = body_label[model.geom_bodyid]
+    if scene.bin is not None:
+        geom_label[[model.geom(name).id for name, _, _ in scene.bin.geoms()[1:]]] = BIN_LABEL
+    return np.where(geom >= 0, geom_label[np.maximum(geom, 0)], 0)
+
+
 def pixel_rays(intrinsics: Intrinsics) -> np.ndarray:
     """(height, width, 3) float: per pixel centre, the ray direction with unit z (camera frame)."""
     u, v = np.meshgrid(np.arange(intrinsics.width, dtype=float), np.arange(intrinsics.height, dtype=float))
@@ -177,6 +200,7 @@ def pixel_rays(intrinsics: Intrinsics) -> np.ndarray:
 
 
 def _view(scene: Scene, view):
+    view = scene.view if view is None else view
     if view is None:
         return scene.camera.position, R_WORLD_CAMERA
     eye, R_world_camera = view

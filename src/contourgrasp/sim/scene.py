@@ -12,11 +12,18 @@ The object is placed with its resting face down at a random position inside
 :class:`Workspace` and a random yaw (both from the seed), then left to settle
 for :data:`SETTLE_TIME` before anything looks at it.
 
+A scene may also hold neighbours (bodies ``neighbour_0``, ...) and a
+:class:`Bin`, whose floor's top is then the plane z = 0 and the table that much
+lower; :mod:`contourgrasp.sim.clutter` arranges and builds such scenes, and
+:attr:`Scene.view` is their tilted camera.
+
 Contacts
 --------
 Object contacts are explicit pairs with the object's own frictions (glove and
-table, see :mod:`contourgrasp.sim.objects`); hand geoms collide with the table
-by their contact bits and never with each other. Solver settings follow what
+table, see :mod:`contourgrasp.sim.objects`; object on object, the mean of their
+table frictions; the bin's floor as the table, its walls without rolling
+friction); hand geoms collide with the table and the bin by their contact bits
+and never with each other. Solver settings follow what
 makes grasps hold in MuJoCo: elliptic friction cones, ``impratio`` 10, the
 ``implicitfast`` integrator, a 2 ms step.
 """
@@ -35,7 +42,7 @@ import mujoco  # noqa: E402
 from ..hand import Hand  # noqa: E402
 from ..perception import Intrinsics  # noqa: E402
 from ..io.hand_file import load_hand  # noqa: E402
-from ..tolerances import SENSOR_RANGE  # noqa: E402
+from ..tolerances import NEIGHBOUR_LIFT, SENSOR_RANGE  # noqa: E402
 from .hand_model import HAND_BIT, TABLE_BIT, HandDesign, HandModel, build_hand  # noqa: E402
 from .objects import ObjectSpec, Part, object_spec  # noqa: E402
 
@@ -49,6 +56,10 @@ PARK_HEIGHT = 2.0
 ROLLING = 0.0005
 #: Rotation from the camera optical frame to the world frame.
 R_WORLD_CAMERA = np.diag([1.0, -1.0, -1.0])
+#: Height from which the neighbours of a scene of several objects are dropped, m.
+DROP_HEIGHT = 0.003
+#: Half extents (x, y) of the table top, m.
+TABLE_HALF = (0.6, 0.45)
 
 
 #: The simulated camera: an Intel RealSense SR300 depth stream at 640 x 480 as librealsense reports it
@@ -98,6 +109,45 @@ class Workspace:
 
 
 @dataclass(frozen=True)
+class Bin:
+    """An open box fixed on the table (issue 17's bin scene): floor, four walls, all of thickness ``wall``.
+
+    World frame: the floor's top is the plane z = 0 on which the objects rest (the
+    table around the bin lies ``floor`` lower), centred on the camera's axis.
+
+    Attributes
+    ----------
+    inner : (float, float)
+        Floor inside the walls, x and y, m.
+    height : float
+        Of the walls above the floor, m.
+    wall, floor : float
+        Thickness of the walls and of the floor, m.
+    rgba : (4,) float
+    """
+
+    inner: tuple[float, float] = (0.40, 0.30)
+    height: float = 0.10
+    wall: float = 0.005
+    floor: float = 0.004
+    rgba: tuple[float, float, float, float] = (0.25, 0.40, 0.60, 1.0)
+
+    def geoms(self) -> list[tuple[str, tuple[float, float, float], tuple[float, float, float]]]:
+        """(name, half sizes, centre) of the floor ``bin_floor`` and the walls ``bin_wall_0`` ... ``bin_wall_3``."""
+        hx, hy, t, h = self.inner[0] / 2, self.inner[1] / 2, self.wall, self.height
+        boxes = [("bin_floor", (hx + t, hy + t, self.floor / 2), (0.0, 0.0, -self.floor / 2))]
+        for k, sign in enumerate((-1.0, 1.0)):
+            boxes.append((f"bin_wall_{k}", (t / 2, hy + t, h / 2), (sign * (hx + t / 2), 0.0, h / 2)))
+            boxes.append((f"bin_wall_{k + 2}", (hx, t / 2, h / 2), (0.0, sign * (hy + t / 2), h / 2)))
+        return boxes
+
+    def contains(self, xy) -> np.ndarray:
+        """(...) bool: whether world points (..., 2) lie over the floor inside the walls."""
+        xy = np.asarray(xy, dtype=float)
+        return (np.abs(xy[..., 0]) < self.inner[0] / 2) & (np.abs(xy[..., 1]) < self.inner[1] / 2)
+
+
+@dataclass(frozen=True)
 class Placement:
     """The object's placement on the table before settling: world x, y (m) and yaw (rad) about world z."""
 
@@ -114,15 +164,28 @@ class Scene:
     model : mujoco.MjModel
     data : mujoco.MjData
     object : ObjectSpec
+        The object to grasp (the target), body ``object``.
     hand : HandModel
     camera : Camera
+        The top-down reference camera: its frame is the one grasps are executed in.
     placement : Placement
+    kind : str
+        ``"single"``, ``"clutter"`` or ``"bin"`` (:mod:`contourgrasp.sim.clutter`).
+    neighbours : tuple of ObjectSpec
+        The other objects, bodies ``neighbour_0``, ``neighbour_1``, ...
+    bin : Bin or None
+    view : (eye, R_world_camera) or None
+        Where the planner's picture is taken from when not from ``camera`` (a tilted camera).
     """
 
-    def __init__(self, model, data, obj: ObjectSpec, hand: HandModel, camera: Camera, placement: Placement):
+    def __init__(self, model, data, obj: ObjectSpec, hand: HandModel, camera: Camera, placement: Placement, *,
+                 kind: str = "single", neighbours: tuple[ObjectSpec, ...] = (), bin: Bin | None = None, view=None):
         self.model, self.data = model, data
         self.object, self.hand, self.camera, self.placement = obj, hand, camera, placement
+        self.kind, self.neighbours, self.bin, self.view = kind, tuple(neighbours), bin, view
         self._object_body = model.body("object").id
+        self._neighbour_bodies = np.array([model.body(f"neighbour_{k}").id for k in range(len(self.neighbours))],
+                                          dtype=int)
         self._palm = model.body("palm").id
         self._base_qpos = np.array([model.joint(j).qposadr[0] for j in BASE_JOINTS])
         self._base_ctrl = np.array([model.actuator(j).id for j in BASE_JOINTS])
@@ -144,6 +207,42 @@ class Scene:
     def object_com(self) -> np.ndarray:
         """(3,) float: the object's centre of mass, world."""
         return self.data.xipos[self._object_body].copy()
+
+    def neighbour_coms(self) -> np.ndarray:
+        """(k, 3) float: the neighbours' centres of mass, world."""
+        return self.data.xipos[self._neighbour_bodies].copy()
+
+    def obstacle_geoms(self) -> np.ndarray:
+        """Geom ids the hand must not touch: every neighbour's, and the bin's walls (not its floor)."""
+        model = self.model
+        neighbours = np.isin(model.geom_bodyid, self._neighbour_bodies)
+        walls = [model.geom(name).id for name, _, _ in (self.bin.geoms()[1:] if self.bin else [])]
+        return np.union1d(np.flatnonzero(neighbours), walls).astype(int)
+
+    def displaced_neighbours(self, rest) -> list[int]:
+        """Neighbours (indices) lifted or knocked off since their centres of mass were at ``rest`` (k, 3).
+
+        Lifted: risen more than :data:`~contourgrasp.tolerances.NEIGHBOUR_LIFT`; knocked off: the
+        centre of mass is no longer over the table (over the bin's floor, in a bin) or below its top.
+        """
+        now = self.neighbour_coms()
+        support = self.bin.contains(now[:, :2]) if self.bin else np.all(np.abs(now[:, :2]) < TABLE_HALF, axis=1)
+        gone = (now[:, 2] - np.asarray(rest)[:, 2] > NEIGHBOUR_LIFT) | ~support | (now[:, 2] < 0.0)
+        return [int(k) for k in np.flatnonzero(gone)]
+
+    def to_reference(self, T_view_hand) -> tuple[float, float, float, float]:
+        """A hand pose planned in :attr:`view`'s optical frame as (x, y, yaw, approach depth) in :attr:`camera`'s.
+
+        The hand's reference point is kept; its approach is taken along the
+        world's vertical (the planner's is the table normal it estimated, a
+        fraction of a degree off) and its yaw from its x axis projected on the
+        table. The approach depth is that point's depth in the reference camera.
+        """
+        eye, R_world_view = self.view
+        T = np.asarray(T_view_hand, dtype=float)
+        origin = self.camera.from_world(R_world_view @ T[:3, 3] + eye)
+        x_axis = R_WORLD_CAMERA.T @ R_world_view @ T[:3, 0]
+        return float(origin[0]), float(origin[1]), float(np.arctan2(x_axis[1], x_axis[0])), float(origin[2])
 
     def object_points(self) -> np.ndarray:
         """(p, 3) float: surface points of the object's collision parts where it lies now, world."""
@@ -252,18 +351,20 @@ def _compile(xml: str, hand) -> mujoco.MjModel:
     return spec.compile()
 
 
-def scene_xml(obj: ObjectSpec, hand: HandModel, placement: Placement) -> str:
-    """The MJCF text of the whole scene."""
-    assets, geoms = [], []
-    collide_group = 3 if obj.visual else 0  # hidden from the camera when a visual mesh stands for it
-    volumes = np.array([_volume(p) for p in obj.collision])
-    for i, part in enumerate(obj.collision):
-        mass = obj.mass * volumes[i] / volumes.sum()
-        geoms.append(_geom_xml(f"object_{i}", part, assets, group=collide_group, rgba=obj.rgba, mass=mass))
-    for i, part in enumerate(obj.visual):
-        geoms.append(_geom_xml(f"object_visual_{i}", part, assets, group=1, rgba=obj.rgba, mass=0.0))
-    quat = (np.cos(placement.yaw / 2), 0.0, 0.0, np.sin(placement.yaw / 2))
-    pairs = _pairs(obj, hand)
+def scene_xml(obj: ObjectSpec, hand: HandModel, placement: Placement, *, neighbours=(), bin: Bin | None = None) -> str:
+    """The MJCF text of the whole scene.
+
+    The object is body ``object``; ``neighbours``, (ObjectSpec, Placement)
+    pairs, are bodies ``neighbour_0``, ... dropped from :data:`DROP_HEIGHT`;
+    a ``bin`` is fixed to the world, its floor's top at z = 0 and the table
+    that much lower.
+    """
+    assets = []
+    bodies = [_body_xml("object", obj, placement, assets, z=0.001)]
+    bodies += [_body_xml(f"neighbour_{k}", o, p, assets, z=DROP_HEIGHT) for k, (o, p) in enumerate(neighbours)]
+    statics = [] if bin is None else [_box_xml(name, size, pos, bin.rgba) for name, size, pos in bin.geoms()]
+    table_z = -0.02 - (bin.floor if bin is not None else 0.0)
+    pairs = _pairs([("object", obj), *((f"neighbour_{k}", o) for k, (o, _) in enumerate(neighbours))], hand, bin)
     return f"""<mujoco model="contourgrasp-sim">
   <compiler angle="radian" autolimits="true"/>
   <option timestep="{TIMESTEP}" integrator="implicitfast" cone="elliptic" impratio="10"/>
@@ -271,12 +372,9 @@ def scene_xml(obj: ObjectSpec, hand: HandModel, placement: Placement) -> str:
     {chr(10).join(assets)}
   </asset>
   <worldbody>
-    <geom name="table" type="box" size="0.6 0.45 0.02" pos="0 0 -0.02" rgba="0.86 0.84 0.78 1"
+    <geom name="table" type="box" size="{TABLE_HALF[0]:g} {TABLE_HALF[1]:g} 0.02" pos="0 0 {table_z:.9g}" rgba="0.86 0.84 0.78 1"
           friction="0.5 0.005 0.0001" contype="{TABLE_BIT}" conaffinity="{HAND_BIT}" group="0"/>
-    <body name="object" pos="{placement.x:.9g} {placement.y:.9g} 0.001" quat="{' '.join(f'{q:.9g}' for q in quat)}">
-      <freejoint name="object"/>
-      {chr(10).join(geoms)}
-    </body>
+    {(chr(10) + '    ').join(statics + bodies)}
     {hand.body_xml()}
   </worldbody>
   <contact>
@@ -291,17 +389,57 @@ def scene_xml(obj: ObjectSpec, hand: HandModel, placement: Placement) -> str:
 </mujoco>"""
 
 
-def _pairs(obj: ObjectSpec, hand: HandModel) -> list[str]:
-    # condim 4 with a little torsional friction: fingertip pads resist spinning the object.
-    grip = f'condim="4" friction="{obj.friction_hand} {obj.friction_hand} 0.005 0.0001 0.0001" solref="0.01 1"'
-    # condim 6: a little rolling resistance (0.5 mm, c_rr ~ 0.015 for a can) stops a nudged can rolling off.
-    rest = (f'condim="6" friction="{obj.friction_table} {obj.friction_table} 0.005 {ROLLING} {ROLLING}" '
-            'solref="0.01 1"')
+def _body_xml(name: str, obj: ObjectSpec, placement: Placement, assets: list[str], *, z: float) -> str:
+    """A free body of ``obj``'s parts: collision geoms ``<name>_<i>``, drawn meshes ``<name>_visual_<i>``."""
+    geoms = []
+    collide_group = 3 if obj.visual else 0  # hidden from the camera when a visual mesh stands for it
+    volumes = np.array([_volume(p) for p in obj.collision])
+    for i, part in enumerate(obj.collision):
+        mass = obj.mass * volumes[i] / volumes.sum()
+        geoms.append(_geom_xml(f"{name}_{i}", part, assets, group=collide_group, rgba=obj.rgba, mass=mass))
+    for i, part in enumerate(obj.visual):
+        geoms.append(_geom_xml(f"{name}_visual_{i}", part, assets, group=1, rgba=obj.rgba, mass=0.0))
+    quat = (np.cos(placement.yaw / 2), 0.0, 0.0, np.sin(placement.yaw / 2))
+    return f"""<body name="{name}" pos="{placement.x:.9g} {placement.y:.9g} {z:g}" quat="{' '.join(f'{q:.9g}' for q in quat)}">
+      <freejoint name="{name}"/>
+      {chr(10).join(geoms)}
+    </body>"""
+
+
+def _box_xml(name: str, size, pos, rgba) -> str:
+    """A fixed box the hand collides with, as with the table."""
+    return (f'<geom name="{name}" type="box" size="{" ".join(f"{v:.9g}" for v in size)}" '
+            f'pos="{" ".join(f"{v:.9g}" for v in pos)}" rgba="{" ".join(f"{v:.4g}" for v in rgba)}" '
+            f'contype="{TABLE_BIT}" conaffinity="{HAND_BIT}" group="0"/>')
+
+
+def _pairs(bodies, hand: HandModel, bin: Bin | None = None) -> list[str]:
+    """Contact pairs of the objects' parts ((name, ObjectSpec) per body) with the table, the hand, each other, the bin."""
     pairs = []
-    for i in range(len(obj.collision)):
-        pairs.append(f'<pair geom1="object_{i}" geom2="table" {rest}/>')
-        pairs += [f'<pair geom1="object_{i}" geom2="{g}" {grip}/>' for g in hand.geom_names()]
+    parts = {name: [f"{name}_{i}" for i in range(len(obj.collision))] for name, obj in bodies}
+    for name, obj in bodies:
+        # condim 4 with a little torsional friction: fingertip pads resist spinning the object.
+        grip = f'condim="4" friction="{obj.friction_hand} {obj.friction_hand} 0.005 0.0001 0.0001" solref="0.01 1"'
+        for geom in parts[name]:
+            pairs.append(f'<pair geom1="{geom}" geom2="table" {_resting(obj)}/>')
+            pairs += [f'<pair geom1="{geom}" geom2="{g}" {grip}/>' for g in hand.geom_names()]
+    for k, (name, obj) in enumerate(bodies):
+        for other, spec in bodies[k + 1:]:
+            mu = (obj.friction_table + spec.friction_table) / 2  # no data for object on object: their mean on the table
+            pairs += [f'<pair geom1="{a}" geom2="{b}" condim="3" friction="{mu} {mu}" solref="0.01 1"/>'
+                      for a in parts[name] for b in parts[other]]
+    for name, obj in bodies if bin is not None else ():
+        for box, _, _ in bin.geoms():
+            how = _resting(obj) if box == "bin_floor" else \
+                f'condim="3" friction="{obj.friction_table} {obj.friction_table}" solref="0.01 1"'
+            pairs += [f'<pair geom1="{geom}" geom2="{box}" {how}/>' for geom in parts[name]]
     return pairs
+
+
+def _resting(obj: ObjectSpec) -> str:
+    # condim 6: a little rolling resistance (0.5 mm, c_rr ~ 0.015 for a can) stops a nudged can rolling off.
+    return (f'condim="6" friction="{obj.friction_table} {obj.friction_table} 0.005 {ROLLING} {ROLLING}" '
+            'solref="0.01 1"')
 
 
 def _geom_xml(name: str, part: Part, assets: list[str], *, group: int, rgba, mass: float) -> str:

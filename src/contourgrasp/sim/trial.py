@@ -36,7 +36,20 @@ Failure causes (chapter 5), first that applies:
   more than :attr:`Execution.push_tolerance` in the plane when the last finger
   touched it (or closing ended with fingers still on air), and it was not lifted;
 * ``"slipped during lift"`` -- the object did not rise ``success_lift``;
-* ``"dropped"`` -- it rose, then fell or slid in the hand during the hold.
+* ``"dropped"`` -- it rose, then fell or slid in the hand during the hold;
+* ``"hit a neighbour or the bin"`` -- in a scene of several objects
+  (:mod:`contourgrasp.sim.clutter`): a hand geom touched a neighbour or a bin
+  wall while descending (the descent stops there, as for a strike, unless the
+  target was touched too: then it is a strike) or closing, or at the end of the
+  hold a neighbour had risen more than :data:`~contourgrasp.tolerances.NEIGHBOUR_LIFT`
+  or left the table (the bin's floor). It fails the trial whatever became of the
+  target, and comes before pushed, slipped and dropped: a collision is a failure
+  of the plan even when the target is held. Touching the bin's floor is not a hit
+  (the fingertips close just above it, as above the table).
+
+In a scene of several objects success is the target's success (above) with
+no hit: no neighbour or wall touched while descending or closing, none lifted
+or knocked off. A single object has no neighbour, so its trials are unchanged.
 """
 
 from __future__ import annotations
@@ -49,6 +62,7 @@ import numpy as np
 
 from ..errors import InputError, NoFeasibleGrasp, SimulationError
 from ..hand import Hand
+from .clutter import build_clutter, target_pixel
 from .hand_model import HandDesign
 from .render import render
 from .scene import Camera, Scene, Workspace, build_scene
@@ -58,8 +72,9 @@ STRUCK = "a finger struck the object while descending"
 PUSHED = "object pushed away before all fingers touched"
 SLIPPED = "slipped during lift"
 DROPPED = "dropped"
-#: Every failure cause a trial can report.
-FAILURE_CAUSES = (NO_PLAN, STRUCK, PUSHED, SLIPPED, DROPPED)
+HIT = "hit a neighbour or the bin"
+#: Every failure cause a trial can report (HIT only in a scene of several objects).
+FAILURE_CAUSES = (NO_PLAN, STRUCK, PUSHED, SLIPPED, DROPPED, HIT)
 #: Angle of the hand's x axis from the object's x axis in :func:`scripted_grasp`, rad.
 SCRIPTED_TILT = math.radians(20.0)
 
@@ -171,7 +186,8 @@ class TrialRecord:
 
 def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finger-linear", noise=True,
               timing: str = "thesis", design: HandDesign = HandDesign(), camera: Camera = Camera(),
-              workspace: Workspace = Workspace(), execution: Execution = Execution(), observe=None) -> TrialRecord:
+              workspace: Workspace = Workspace(), execution: Execution = Execution(), observe=None,
+              scene_kind: str = "single", pool=()) -> TrialRecord:
     """Place the object (seeded), take an RGB-D picture, plan, execute, and record the outcome.
 
     Parameters
@@ -187,7 +203,11 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
         (4, 4) hand pose in the camera frame (see :func:`hand_pose_from_matrix`)
         and the approach depth (m), and optionally the planned grasp height (m, see
         :func:`execute_grasp`; None or left out: the execution's own rule). It may raise ``NoFeasibleGrasp`` or
-        ``InputError`` when it has no plan.
+        ``InputError`` when it has no plan. In a scene of several objects it is
+        called with the keyword ``target_px``, the target's pixel (u, v)
+        (:func:`~contourgrasp.sim.clutter.target_pixel`), and its pose, planned
+        in the tilted camera's frame, is executed from the reference camera's
+        (:meth:`~contourgrasp.sim.scene.Scene.to_reference`).
     hand : Hand or str
         The hand preset the simulated hand is built from.
     noise : DepthNoise or bool
@@ -199,14 +219,25 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
     observe : callable, optional
         ``observe(scene)`` is called when the trial ends (after the hold, an
         aborted descent, or the picture when there is no plan), e.g. to render it.
+    scene_kind : {"single", "clutter", "bin"}
+        The scene (:mod:`contourgrasp.sim.clutter`); ``object_spec`` is its target.
+    pool : sequence of ObjectSpec
+        The neighbours of a ``clutter`` or ``bin`` scene are drawn from it.
     """
     started = time.perf_counter()
-    scene = build_scene(object_spec, seed=seed, hand=hand, design=design, timing=timing, camera=camera,
-                        workspace=workspace)
+    options = {"hand": hand, "design": design, "timing": timing, "camera": camera, "workspace": workspace}
+    if scene_kind == "single":
+        scene = build_scene(object_spec, seed=seed, **options)
+    else:
+        scene = build_clutter(object_spec, pool, kind=scene_kind, seed=seed, **options)
     rgb, depth = render(scene, noise=noise, seed=seed)
+    target = {} if scene.view is None else {"target_px": target_pixel(scene)}
     planning = time.perf_counter()
     try:
-        transform, approach_depth, *planned_height = planner(rgb, depth, camera.intrinsics)
+        transform, approach_depth, *planned_height = planner(rgb, depth, camera.intrinsics, **target)
+        if scene.view is not None:
+            *pose, approach_depth = scene.to_reference(transform)
+            transform = pose_matrix(*pose, approach_depth)
         plan_error = None
     except (NoFeasibleGrasp, InputError) as err:
         plan_error = str(err)
@@ -268,14 +299,20 @@ def execute_grasp(scene: Scene, transform, approach_depth: float, execution: Exe
         lowest = max(f.radius for f in scene.hand.fingers) + execution.tip_clearance
         palm_final = max(scene.hand.tip_depth + lowest, top + execution.palm_clearance)
     else:
-        palm_final = scene.hand.open_tip_depth + float(grasp_height)
+        depth = getattr(scene.hand, "open_tip_depth", None)
+        if depth is None:
+            raise SimulationError(f"the simulated hand {scene.hand.hand.name!r} has no open fingertip depth: "
+                                  "it cannot execute a planned grasp height")
+        palm_final = depth + float(grasp_height)
     palm_start = max(palm_final, top + execution.approach_height + scene.hand.tip_depth)
     probe = _Probe(scene)
     pose = (x, y, yaw)
+    rest = scene.neighbour_coms()
 
     scene.set_hand(*world_xy, palm_start, yaw)
     if _descend(scene, probe, world_xy, yaw, palm_start, palm_final, execution):
-        return GraspOutcome(False, STRUCK, (), (), 0.0, 0.0, 0.0, pose, scene.camera.height - palm_final)
+        cause = HIT if probe.hit and not probe.touching() else STRUCK
+        return GraspOutcome(False, cause, (), (), 0.0, 0.0, 0.0, pose, scene.camera.height - palm_final)
     first_contact, push = _close(scene, probe, world_xy, yaw, palm_final, execution)
     touching = probe.fingers_touching()
     lift, lifted, drift = _lift_and_hold(scene, world_xy, yaw, palm_final, execution)
@@ -286,29 +323,38 @@ def execute_grasp(scene: Scene, transform, approach_depth: float, execution: Exe
         cause = PUSHED if push > execution.push_tolerance else SLIPPED
     else:
         cause = DROPPED
+    if probe.hit or scene.displaced_neighbours(rest):
+        success, cause = False, HIT
     return GraspOutcome(success, cause, touching, first_contact, push, lift, drift, pose,
                         scene.camera.height - palm_final)
 
 
 class _Probe:
-    """Which hand geoms touch the object, by finger."""
+    """Which hand geoms touch the object, by finger; :attr:`hit` once any touched an obstacle (neighbour, bin wall)."""
 
     def __init__(self, scene: Scene):
         model = scene.model
         self.scene = scene
+        self.hit = False
+        self.obstacle_geoms = scene.obstacle_geoms()
         self.object_geoms = np.flatnonzero(model.geom_bodyid == model.body("object").id)
         self.finger_of = {}  # hand geom id -> finger index (-1: palm and posts)
         for name in scene.hand.geom_names():
             finger = next((i for i, f in enumerate(scene.hand.fingers) if name.startswith(f"{f.name}_")
                            and not name.endswith("_post")), -1)
             self.finger_of[model.geom(name).id] = finger
+        self.hand_geoms = np.fromiter(self.finger_of, dtype=int)
 
     def touching(self) -> set[int]:
-        """Finger indices (-1 for palm or post) in contact with the object now."""
+        """Finger indices (-1 for palm or post) in contact with the object now (and :attr:`hit` updated)."""
         data = self.scene.data
         if data.ncon == 0:
             return set()
         pairs = data.contact.geom[: data.ncon]
+        if len(self.obstacle_geoms) and not self.hit:
+            hand = np.isin(pairs, self.hand_geoms)
+            obstacle = np.isin(pairs, self.obstacle_geoms)
+            self.hit = bool(np.any((hand[:, 0] & obstacle[:, 1]) | (hand[:, 1] & obstacle[:, 0])))
         found = set()
         for g1, g2 in pairs:
             if g1 in self.object_geoms and g2 in self.finger_of:
@@ -323,16 +369,16 @@ class _Probe:
 
 
 def _descend(scene, probe, xy, yaw, z_start, z_end, execution) -> bool:
-    """Lower the palm from z_start to z_end; True when the hand touched the object on the way."""
+    """Lower the palm from z_start to z_end; True when the hand touched the object (or an obstacle) on the way."""
     steps = max(1, round((z_start - z_end) / execution.descend_speed / scene.model.opt.timestep))
     for z in np.linspace(z_start, z_end, steps):
         scene.command([*xy, z, yaw], 0.0)
         scene.step()
-        if probe.touching():
+        if probe.touching() or probe.hit:
             return True
     for _ in range(round(execution.settle_time / scene.model.opt.timestep)):
         scene.step()
-        if probe.touching():
+        if probe.touching() or probe.hit:
             return True
     return False
 

@@ -59,3 +59,16 @@ def test_a_split_names_objects_the_bench_runs(splits, message):
 def test_an_unknown_name_is_refused_before_any_object_is_loaded():
     with pytest.raises(SimulationError, match="unknown object 'teapot'"):
         resolve_objects("thesis,teapot")
+
+
+def test_a_scene_of_several_objects_draws_neighbours_from_the_targets_split():
+    objects = thesis_objects(["can", "case", "bottle", "stone1"])
+    bench = Bench(objects=objects, trials=1, scene_kind="clutter",
+                  splits=(("train", ("can", "case")), ("test", ("bottle",))))
+    assert [o.name for o in bench.pool("can")] == ["case"]
+    assert [o.name for o in bench.pool("bottle")] == ["bottle"]  # alone in its split: beside copies of itself
+    assert [o.name for o in bench.pool("stone1")] == ["can", "case", "bottle"]  # in no split: beside all the others
+    assert "hit a neighbour or the bin" in bench.causes
+    assert "hit a neighbour or the bin" not in Bench(objects=objects, trials=1).causes
+    with pytest.raises(SimulationError, match="scene must be one of"):
+        Bench(objects=objects, trials=1, scene_kind="heap")

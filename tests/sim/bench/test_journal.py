@@ -98,3 +98,10 @@ def test_settings_name_what_decides_the_trials():
     assert settings(one) == settings(Bench(objects=thesis_objects(["can", "case"]), planners=("paper",), trials=2))
     assert settings(one)["objects"] == ["can", "case"] and settings(one)["trials"] == 2
     assert digest(one.objects[0]) != digest(one.objects[1])
+
+
+def test_the_scene_is_a_setting_only_when_it_is_not_single():
+    single = Bench(objects=thesis_objects(["can"]), planners=("paper",), trials=1)
+    assert "scene" not in settings(single)  # journals written before there were scenes resume
+    assert settings(Bench(objects=thesis_objects(["can"]), planners=("paper",), trials=1, scene_kind="bin"))["scene"] \
+        == "bin"

@@ -124,3 +124,14 @@ def test_the_failure_mosaic_shows_the_ranking_planner_first_worst_objects_first(
         object.__setattr__(r.record, "pose", (0.0, 0.0, 0.0))  # as if every trial had a plan
     picked = [(r.planner, r.record.object, r.trial) for r in picked_failures(bench, results, limit=3)]
     assert picked == [("default", "case", 0), ("default", "can", 1), ("paper", "can", 0)]
+
+
+def test_a_bin_bench_reports_its_scene_and_the_hit_cause(tmp_path, capsys):
+    out = tmp_path / "bin"
+    code, _ = run_cli(["bench", "--scene", "bin", "--objects", "can,stone2", "--trials", "1", "--planners",
+                       "centroid-principal-axis", "--workers", "1", "--out", out], capsys)
+    assert code == 0
+    table = (out / "table.md").read_text()
+    assert "Scene `bin`: 1-3 objects in a bin" in table and "| hit a neighbour or the bin |" in table
+    assert "without the hand touching a neighbour or a bin wall" in table
+    assert [r["object"] for r in json.loads((out / "trials.json").read_text())] == ["can", "stone2"]

@@ -7,12 +7,13 @@ from dataclasses import dataclass, field
 from ...errors import SimulationError
 from ...hand import Hand
 from ...io.hand_file import load_hand
-from ...validation import integer
+from ...validation import choice, integer
+from ..clutter import SCENE_KINDS
 from ..hand_model import build_hand
 from ..objects import THESIS_OBJECTS, ObjectSpec, object_spec
 from ..planners import BASELINES, make_planner, synthesis_planner
 from ..scene import Camera, Workspace
-from ..trial import DROPPED, NO_PLAN, PUSHED, SLIPPED, STRUCK, TrialRecord, run_trial
+from ..trial import DROPPED, FAILURE_CAUSES, HIT, NO_PLAN, PUSHED, SLIPPED, STRUCK, TrialRecord, run_trial
 from ..ycb import OBJECT_SETS, load_object, object_names
 
 #: Success rates of Table 4.4 (real arm and qbHand, 10 trials per object).
@@ -20,7 +21,8 @@ THESIS_SUCCESS = {"can": 0.8, "case": 0.4, "bottle": 0.7, "stone1": 0.2, "stone2
 #: Column headings of Table 4.4 for the simulated objects.
 LABELS = {"can": "can", "case": "glasses case", "bottle": "bottle", "stone1": "stone 1", "stone2": "stone 2"}
 #: Short failure causes for the trial tables.
-SHORT_CAUSES = {NO_PLAN: "no plan", STRUCK: "struck", PUSHED: "pushed", SLIPPED: "slipped", DROPPED: "dropped"}
+SHORT_CAUSES = {NO_PLAN: "no plan", STRUCK: "struck", PUSHED: "pushed", SLIPPED: "slipped", DROPPED: "dropped",
+                HIT: "hit"}
 
 
 @dataclass(frozen=True)
@@ -50,6 +52,10 @@ class Bench:
     hand_model : MountedHand, optional
         A MuJoCo hand model simulated as itself (:func:`~contourgrasp.sim.model_mount.mount_model`);
         ``hand`` is then its derived hand file. None: the simulated hand is built from ``hand``.
+    scene_kind : {"single", "clutter", "bin"}
+        The scene of every trial (:mod:`contourgrasp.sim.clutter`). In
+        ``clutter`` and ``bin`` each object is in turn the target, its
+        neighbours drawn from :meth:`pool`.
 
     Raises
     ------
@@ -69,8 +75,10 @@ class Bench:
     workspace: Workspace = field(default_factory=Workspace)
     splits: tuple[tuple[str, tuple[str, ...]], ...] = ()
     hand_model: object = None
+    scene_kind: str = "single"
 
     def __post_init__(self):
+        choice("scene", self.scene_kind, SCENE_KINDS, error=SimulationError)
         object.__setattr__(self, "objects", tuple(self.objects))
         object.__setattr__(self, "planners", tuple(self.planners))
         object.__setattr__(self, "splits", tuple((str(s), tuple(members)) for s, members in self.splits))
@@ -106,6 +114,18 @@ class Bench:
         """The first split the object called ``name`` belongs to (None: none)."""
         return next((split for split, members in self.splits if name in members), None)
 
+    def pool(self, name: str) -> tuple[ObjectSpec, ...]:
+        """The neighbours of the target called ``name``: the bench's other objects of its split (all, without
+        splits), so that ``ycb-test`` targets stand among ``ycb-test`` objects; the object itself when it is alone."""
+        split = self.split_of(name)
+        members = dict(self.splits)[split] if split else [o.name for o in self.objects]
+        return tuple(o for o in self.objects if o.name in members and o.name != name) or (self.object(name),)
+
+    @property
+    def causes(self) -> tuple[str, ...]:
+        """The failure causes its trials can have: the hit of a neighbour only where there are neighbours."""
+        return FAILURE_CAUSES if self.scene_kind != "single" else tuple(c for c in FAILURE_CAUSES if c != HIT)
+
     def tasks(self) -> list[tuple[str, int, int]]:
         """Every trial as (planner, object index, trial), object by object (so objects finish one after another)."""
         return [(planner, index, trial) for index in range(len(self.objects)) for planner in self.planners
@@ -114,9 +134,11 @@ class Bench:
     def run(self, planner: str, obj: ObjectSpec, trial: int, *, plan=None, observe=None) -> TrialRecord:
         """Run one trial; ``plan`` replaces the named planner's callable (same answers), ``observe`` see run_trial."""
         seed = self.seed + trial
+        pool = self.pool(obj.name) if self.scene_kind != "single" else ()
         return run_trial(obj, seed=seed, planner=plan or make_planner(planner, self.hand, seed=seed),
                          hand=self.hand if self.hand_model is None else self.hand_model,
-                         noise=self.noise, camera=self.camera, workspace=self.workspace, observe=observe)
+                         noise=self.noise, camera=self.camera, workspace=self.workspace, observe=observe,
+                         scene_kind=self.scene_kind, pool=pool)
 
 
 @dataclass(frozen=True)

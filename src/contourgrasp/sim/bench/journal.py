@@ -30,9 +30,12 @@ def settings(bench: Bench) -> dict:
     """What decides a bench's trials, by setting name: two benches with equal settings run the same trials.
 
     Object and hand geometry, planner options and scene parameters enter as
-    short digests beside the names a reader recognises.
+    short digests beside the names a reader recognises. The scene's kind is
+    named only when it is not ``single``, so journals written before there
+    were kinds resume.
     """
-    return {
+    kind = {} if bench.scene_kind == "single" else {"scene": bench.scene_kind}
+    return kind | {
         "objects": [o.name for o in bench.objects],
         "object geometry": [f"{o.name} {digest(o)}" for o in bench.objects],
         "planners": list(bench.planners),

@@ -29,7 +29,7 @@ from pathlib import Path
 
 from ...io.plan_file import atomic_outputs, write_json
 from ..planners import BASELINES, ablation_planners, synthesis_planner
-from ..trial import FAILURE_CAUSES, TrialRecord
+from ..trial import TrialRecord
 from .config import SHORT_CAUSES, Bench, BenchTrial, label
 from .run import picked_trials, snapshot
 from .stats import records, sort_planner, success_rates, thesis_rates, wilson_interval
@@ -141,8 +141,7 @@ def markdown(bench: Bench, results, *, wall_time: float, kept: int = 0) -> str:
     for planner in bench.planners:
         lines += ["", f"## {planner}", "", *trial_table(bench, results, planner), "",
                   f"Causes of failure ({planner}):", "", *cause_table(bench, results, planner)]
-    lines += ["", "✓ success; ✗ failure and its cause: " + ", ".join(f"{v} = {k}" for k, v in SHORT_CAUSES.items())
-              + ". Success: lifted at least 0.10 m and moved less than 0.02 m in the hand during the 2 s hold."]
+    lines += ["", "✓ success; ✗ failure and its cause: " + _cause_legend(bench) + ". " + _success_text(bench)]
     return "\n".join(lines) + "\n"
 
 
@@ -153,12 +152,34 @@ def _simulated(bench: Bench) -> str:
     return f"the MuJoCo model {Path(bench.hand_model.path).name} simulated as itself, closed by one synergy"
 
 
+def _cause_legend(bench: Bench) -> str:
+    return ", ".join(f"{SHORT_CAUSES[c]} = {c}" for c in bench.causes)
+
+
+def _success_text(bench: Bench) -> str:
+    text = "Success: lifted at least 0.10 m and moved less than 0.02 m in the hand during the 2 s hold."
+    if bench.scene_kind == "single":
+        return text
+    return (text[:-1] + ", without the hand touching a neighbour or a bin wall while descending or closing, and "
+            "no neighbour lifted or knocked off the table (out of the bin).")
+
+
 def _trials_text(bench: Bench, n_trials: int, wall_time: float, kept: int) -> str:
     resumed = f" ({kept} of them run earlier and kept by --resume)" if kept else ""
     return (f"{len(bench.objects)} object(s) x {bench.trials} trial(s) x {len(bench.planners)} planner(s) = "
-            f"{n_trials} trials in {wall_time:.0f} s wall time{resumed}. Hand `{bench.hand.name}` ({_simulated(bench)}"
-            f"); depth noise {'on' if bench.noise else 'off'}; trial t uses seed {bench.seed} "
-            f"+ t, the same scene for every planner.")
+            f"{n_trials} trials in {wall_time:.0f} s wall time{resumed}. Hand `{bench.hand.name}` X; depth noise {'on' if bench.noise else 'off'}; trial t uses seed {bench.seed} "
+            f"+ t, the same scene for every planner.{_scene_text(bench)}")
+
+
+def _scene_text(bench: Bench) -> str:
+    """What a ``clutter`` or ``bin`` scene is (nothing for ``single``)."""
+    if bench.scene_kind == "single":
+        return ""
+    what = ("2-4 objects on the table" if bench.scene_kind == "clutter" else
+            "1-3 objects in a bin (walls 10 cm, floor 40 x 30 cm)")
+    return (f" Scene `{bench.scene_kind}`: {what}, each object in turn the target among neighbours drawn from the "
+            "other objects of its split, touching or up to 4 cm apart; the camera tilted 0-25 deg; the planner is "
+            "given the pixel deepest inside the target's exact mask, as a user's click.")
 
 
 def _setup_text(bench: Bench, n_trials: int, wall_time: float, kept: int = 0) -> str:
@@ -190,11 +211,11 @@ def ablation_table(bench: Bench, results) -> list[str]:
     steps = [p.name for p in ablation_planners()]
     names = {name: name for name in steps[:-1]} | {steps[-1]: "default"}
     rows = [(step, planner) for step, planner in names.items() if planner in bench.planners]
-    lines = _header("step", ["all", *(SHORT_CAUSES[c] for c in FAILURE_CAUSES)])
+    lines = _header("step", ["all", *(SHORT_CAUSES[c] for c in bench.causes)])
     for step, planner in rows:
         own = records(results, planner)
         shown = step if planner == step else f"{step} = `default`"
-        lines.append(_row([shown, _rate_cell(own), *(sum(r.cause == c for r in own) for c in FAILURE_CAUSES)]))
+        lines.append(_row([shown, _rate_cell(own), *(sum(r.cause == c for r in own) for c in bench.causes)]))
     return lines if rows else []
 
 
@@ -239,7 +260,7 @@ def cause_table(bench: Bench, results, planner: str) -> list[str]:
     objects = [o.name for o in bench.objects]
     own = records(results, planner)
     lines = _header("cause", [label(o) for o in objects] + ["all"])
-    for cause in FAILURE_CAUSES:
+    for cause in bench.causes:
         counts = [sum(r.cause == cause for r in own if r.object == o) for o in objects]
         lines.append(_row([cause, *counts, sum(counts)]))
     return lines
@@ -248,8 +269,9 @@ def cause_table(bench: Bench, results, planner: str) -> list[str]:
 def split_markdown(bench: Bench, results, *, wall_time: float, kept: int = 0) -> str:
     """table.md of a bench with splits: setup, planners, per split, per object, the ablation."""
     splits = ", ".join(f"{name} ({len(members)} objects)" for name, members in bench.splits)
+    scene = "" if bench.scene_kind == "single" else f", scene `{bench.scene_kind}`"
     lines = [
-        f"# contourgrasp bench: {splits}, simulated",
+        f"# contourgrasp bench: {splits}{scene}, simulated",
         "",
         _split_setup_text(bench, len(results), wall_time, kept),
         "",
@@ -275,8 +297,7 @@ def split_markdown(bench: Bench, results, *, wall_time: float, kept: int = 0) ->
     ablation = ablation_table(bench, results)
     if len(ablation) > 3:  # more than one step ran
         lines += ["", "## Ablation: paper to default", "", *ablation]
-    lines += ["", "Success: lifted at least 0.10 m and moved less than 0.02 m in the hand during the 2 s hold. "
-              "Causes: " + ", ".join(f"{v} = {k}" for k, v in SHORT_CAUSES.items()) + "."]
+    lines += ["", _success_text(bench) + " Causes: " + _cause_legend(bench) + "."]
     return "\n".join(lines) + "\n"
 
 
@@ -314,11 +335,11 @@ def split_table(bench: Bench, results) -> list[str]:
 
 def split_cause_table(bench: Bench, results) -> list[str]:
     """Failures per planner and split (rows) by cause (columns)."""
-    lines = _header("planner", ["split", *(SHORT_CAUSES[c] for c in FAILURE_CAUSES)], left=1)
+    lines = _header("planner", ["split", *(SHORT_CAUSES[c] for c in bench.causes)], left=1)
     for planner in bench.planners:
         for split, members in _groups(bench):
             own = _of(results, planner, members)
-            lines.append(_row([planner, split, *(sum(r.cause == c for r in own) for c in FAILURE_CAUSES)]))
+            lines.append(_row([planner, split, *(sum(r.cause == c for r in own) for c in bench.causes)]))
     return lines
 
 
@@ -330,7 +351,7 @@ def object_table(bench: Bench, results) -> list[str]:
     lines = _header("object", ["split", *bench.planners, f"{planner}'s failures"], left=1)
     for name in sorted(names, key=lambda o: (-rates[o], names.index(o))):
         causes = [r.cause for r in records(results, planner, name) if r.cause is not None]
-        failures = ", ".join(f"{SHORT_CAUSES[c]} {causes.count(c)}" for c in FAILURE_CAUSES if c in causes)
+        failures = ", ".join(f"{SHORT_CAUSES[c]} {causes.count(c)}" for c in bench.causes if c in causes)
         cells = [_rate_cell(records(results, p, name)) for p in bench.planners]
         lines.append(_row([label(name), bench.split_of(name) or "—", *cells, failures or "—"]))
     return lines

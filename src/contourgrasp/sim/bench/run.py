@@ -145,8 +145,8 @@ def snapshot(bench: Bench, result: BenchTrial) -> Snapshot:
     planner = make_planner(result.planner, bench.hand, seed=bench.seed + result.trial)
     seen = {}
 
-    def recording(rgb, depth, intrinsics):
-        seen["rgb"], seen["planned"] = rgb, planner.plan(rgb, depth, intrinsics)
+    def recording(rgb, depth, intrinsics, **target):
+        seen["rgb"], seen["planned"] = rgb, planner.plan(rgb, depth, intrinsics, **target)
         return seen["planned"].T_camera_hand, seen["planned"].approach_depth, seen["planned"].grasp_height
 
     def observe(scene):
