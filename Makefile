@@ -27,10 +27,12 @@ bench: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/contourgrasp bench --objects can,case,bottle,stone1,stone2 --trials 20 \
 		--planners paper,default,centroid-principal-axis,random --ablation --out bench-output
 
-# The YCB object set (issue 15): the fixed train and test splits, 10 trials per object, on every core.
+# The YCB object set (issue 15): the fixed train and test splits, 10 trials per object, on every core,
+# with the 3-D hand's ablation (issue 16): the 2-D planner, + finger bodies, + grasp height, = default.
 bench-ycb: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/contourgrasp bench --objects ycb-train,ycb-test --trials 10 \
-		--planners paper,default,centroid-principal-axis,random --workers $$(nproc) --out bench-ycb-output
+		--planners paper,paper+grid+quality,paper+grid+quality+bodies,paper+grid+quality+bodies+height,default,centroid-principal-axis,random \
+		--workers $$(nproc) --out bench-ycb-output
 
 clean:
 	rm -rf $(VENV) demo-output bench-output bench-ycb-output .pytest_cache

@@ -349,8 +349,9 @@ GRASP_TIP_CLEARANCE = 0.003
 GRASP_PALM_CLEARANCE = 0.02
 
 #: Grasp height rule "auto": the grasp height asked for, and the highest accepted where the hand's bodies need
-#: it higher, as fractions of the object's height. Chosen on ycb-train (README, "3-D hand").
-GRASP_HEIGHT_FRACTION = 0.5
+#: it higher, as fractions of the object's height. Chosen on ycb-train and the thesis's five
+#: (benchmarks/hand3d_sweep.md).
+GRASP_HEIGHT_FRACTION = 0.4
 MAX_GRASP_HEIGHT_FRACTION = 0.7
 
 #: perception.cross_section: fewer object cells than this standing at the grasp height (m^2 / cell^2: 50 cells of

@@ -159,18 +159,20 @@ def ablation_planners() -> tuple[Planner, ...]:
     """``paper``, then per :data:`ABLATION_STEPS` step ``default``'s values of its options on top of the last.
 
     Steps are named ``paper+grid``, ``paper+grid+quality``, ...; a step that
-    changes nothing is left out, and the last step has ``default``'s effective options.
+    changes nothing is left out (an option a file leaves unset has the library's default), and the
+    last step has ``default``'s effective options.
     """
     paper, default = load_planner("paper"), load_planner("default")
     options, target = dict(paper.options), dict(default.options)
+    defaults = library_defaults(set(options) | set(target))
     steps, name = [paper], paper.name
     for step, keys in ABLATION_STEPS:
-        changed = {k: target[k] for k in keys if k in target and options.get(k) != target[k]}
+        changed = {k: target[k] for k in keys if k in target and options.get(k, defaults.get(k)) != target[k]}
         if changed:
             options |= changed
             name += f"+{step}"
             steps.append(Planner(name, f"paper with default's {', '.join(changed)}", tuple(options.items())))
-    if options != target:  # options outside every step (e.g. curvature) make a last step of their own
+    if defaults | options != defaults | target:  # options outside every step (e.g. curvature) make a last step
         steps.append(Planner(name + "+other", "paper with all of default's options", default.options))
     return tuple(steps)
 
