@@ -151,8 +151,8 @@ def image_plan_figure(result, rgb=None) -> Figure:
 
     The third panel (:func:`draw_heights`) shows ``result.height_map`` under the planned
     hand's finger paths; without a height map (no table plane) the figure has the first two only.
-    With a planned grasp height and a 3-D hand a fourth (:func:`draw_side_view`) shows the open
-    hand at that height beside the scene's profile, seen along the hand's y axis.
+    With a planned grasp height and a 3-D hand a fourth (:func:`draw_side_view`) shows each finger's
+    open chain at that height over the scene's profile in the finger's own vertical plane.
 
     ``result`` is a :class:`contourgrasp.pipeline.ImageGraspPlan`; ``rgb`` the
     colour image (the depth-derived mask is shown when it is None). Over a
@@ -207,45 +207,39 @@ def image_plan_figure(result, rgb=None) -> Figure:
 
 
 def draw_side_view(ax, heights, plan: GraspPlan, grasp_height: float) -> None:
-    """The open 3-D hand at the grasp height beside the scene, seen along the hand's y axis.
+    """Each finger's body at the grasp height beside the scene, in the vertical plane the finger closes in.
 
-    Horizontal: the hand frame's x; vertical: height above the table. The scene is the highest
-    object (and obstacle) cell at each x over the whole map; each finger's post, proximal and
-    distal links are drawn as thick lines, the palm as a bar above its underside.
+    Horizontal: distance from the finger's knuckle along its chain's direction (toward the object);
+    vertical: height above the table. Per finger, in its colour: the height map's profile along that
+    line (filled; unseen cells at their conservative bound, dotted) and its open chain's links.
     """
     hand = plan.hand
-    x, y, yaw = plan.pose
-    xs, ys = heights.centres()
-    gx, gy = np.meshgrid(xs, ys)
-    along = math.cos(yaw) * (gx - x) + math.sin(yaw) * (gy - y)
     palm_height = grasp_height + hand.open_tip_depth
-    for cells, colour, label in ((heights.object, "0.35", "object"), (heights.obstacles, "tab:gray", "obstacles")):
-        h = np.where(cells & np.isfinite(heights.heights), heights.heights, np.nan)
-        if not np.isfinite(h).any():
-            continue
-        bins = np.round(along / heights.cell).astype(int)
-        keys = bins[np.isfinite(h)]
-        top = np.full(keys.max() - keys.min() + 1, np.nan)
-        np.fmax.at(top, keys - keys.min(), h[np.isfinite(h)])
-        ax.fill_between((np.arange(len(top)) + keys.min()) * heights.cell, 0.0, top, color=colour, step="mid",
-                        alpha=0.7, label=label)
+    u = np.arange(-0.08, 0.14, 0.5 * heights.cell)
+    bound = heights.conservative()
     for i, (finger, chain) in enumerate(zip(hand.fingers, hand.chains)):
         colour = FINGER_COLOURS[i % len(FINGER_COLOURS)]
-        for k, (a, b) in enumerate(chain_capsules(chain, 0.0)[0]):
-            ax.plot([a[0], b[0]], [palm_height - a[2], palm_height - b[2]], color=colour, alpha=0.8,
-                    lw=SIDE_VIEW_LINK_WIDTH, solid_capstyle="round", label=finger.name if k == 0 else None)
-    outline = hand.palm.points[:, 0]
-    ax.fill_between([outline.min(), outline.max()], palm_height, palm_height + hand.palm.thickness, color="0.2",
-                    label="palm")
+        knuckle, direction = np.asarray(chain.knuckle), np.asarray(chain.direction)
+        line = to_image(knuckle + u[:, None] * direction, plan.pose)
+        seen, hidden = heights.at(line), heights.at(line, bound)
+        ax.fill_between(u, 0.0, np.nan_to_num(seen), color=colour, alpha=0.15, step="mid")
+        ax.plot(u, np.where(np.isnan(seen), hidden, np.nan), color=colour, ls=":", lw=1)
+        for a, b in chain_capsules(chain, 0.0)[0]:
+            ua, ub = ((np.array([a[:2], b[:2]]) - knuckle) @ direction)
+            ax.plot([ua, ub], [palm_height - a[2], palm_height - b[2]], color=colour, alpha=0.9,
+                    lw=SIDE_VIEW_LINK_WIDTH, solid_capstyle="round", label=finger.name if a is not None else None)
     ax.axhline(0.0, color="black", lw=1)
+    ax.axhline(palm_height, color="0.2", lw=2, label="palm underside")
     ax.axhline(grasp_height, color="tab:blue", ls=":", lw=1, label=f"grasp height {1e3 * grasp_height:.0f} mm")
     ax.set_aspect("equal")
-    ax.set_xlabel("x along the hand [m]")
+    ax.set_xlabel("m along each finger's plane, from its knuckle")
     ax.set_ylabel("height above the table [m]")
     least = "" if plan.descent is None else (f", least clearance {1e3 * float(plan.descent.clearance[0].min()):.1f} mm "
                                               f"({plan.descent.bodies[int(np.argmin(plan.descent.clearance[0]))]})")
-    ax.set_title(f"side view of the open hand at the grasp{least}", fontsize=10)
-    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    ax.set_title(f"each finger's plane at the grasp: its links and the scene under them{least}", fontsize=10)
+    handles, labels = ax.get_legend_handles_labels()
+    unique = dict(zip(labels, handles))
+    ax.legend(unique.values(), unique.keys(), loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
 
 
 def draw_heights(ax, heights, plan: GraspPlan | None = None, fig: Figure | None = None) -> None:
