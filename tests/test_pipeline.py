@@ -415,3 +415,15 @@ def test_the_small_object_rule_plans_a_strawberry_with_fewer_fingers():
                                  yaw_step=0.1)
     assert result.plan.hand.min_touching < hand.min_touching
     assert sum(not f.missed for f in result.plan.fingers) >= result.plan.hand.min_touching
+
+
+def test_the_3d_plan_figure_shows_each_fingers_plane(standing_can_frame):
+    from contourgrasp.visualize import image_plan_figure
+
+    rgb, depth, K = standing_can_frame
+    result = pipeline.plan_frame(rgb, depth, K, cg.load_hand("five-finger-linear"), descent=True,
+                                 grasp_height="auto", yaw_step=0.1)
+    titles = [ax.get_title() for ax in image_plan_figure(result, rgb).axes]
+    assert any("each finger's plane" in t and "least clearance" in t for t in titles)
+    flat = pipeline.plan_frame(rgb, depth, K, cg.load_hand("five-finger-linear"), yaw_step=0.1)
+    assert not any("each finger's plane" in ax.get_title() for ax in image_plan_figure(flat, rgb).axes)
