@@ -236,7 +236,7 @@ def draw_side_view(ax, heights, plan: GraspPlan, grasp_height: float) -> None:
     ax.set_ylabel("height above the table [m]")
     least = "" if plan.descent is None else (f", least clearance {1e3 * float(plan.descent.clearance[0].min()):.1f} mm "
                                               f"({plan.descent.bodies[int(np.argmin(plan.descent.clearance[0]))]})")
-    ax.set_title(f"each finger's plane at the grasp: its links and the scene under them{least}", fontsize=10)
+    ax.set_title(f"each finger's plane at the grasp{least}", fontsize=10)
     handles, labels = ax.get_legend_handles_labels()
     unique = dict(zip(labels, handles))
     ax.legend(unique.values(), unique.keys(), loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
