@@ -45,6 +45,10 @@ def test_a_file_round_trips_its_options(tmp_path):
     ('name = "x"\nspeed = 3', "speed"),
     ('harmonics = 4', "name"),
     ('name = "x"\nfinger_thickness = 1', "finger_thickness"),
+    ('name = "x"\ndescent = 1', "descent"),
+    ('name = "x"\ngrasp_height = "high"', "grasp_height"),
+    ('name = "x"\ngrasp_height = -0.1', "grasp_height: Value error, a grasp height must be in"),
+    ('name = "x"\nsmall_objects = "yes"', "small_objects"),
 ])
 def test_bad_files_name_the_field(text, field):
     with pytest.raises(PlannerFileError, match=f"mine.toml: {field}"):
@@ -134,3 +138,10 @@ def test_fuzz_load_planner_on_random_bytes_gives_a_planner_or_a_planner_file_err
         assert str(err).startswith(str(path)) and "\n" not in str(err)
         return
     assert planner.name == "x"
+
+
+def test_the_3d_keys_are_plan_options_not_search_options():
+    planner = parse_planner('name = "x"\ndescent = true\ngrasp_height = 0.05\nslice_contour = false\n'
+                            'closing_sweep = true\nsmall_objects = true\nxy_step = 0.02', source="mine.toml")
+    assert planner.plan_options["grasp_height"] == 0.05 and planner.plan_options["descent"] is True
+    assert planner.synthesis_options == {"xy_step": 0.02}

@@ -42,7 +42,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from .. import tolerances as tol
 from ..errors import PlannerError, PlannerFileError
@@ -84,6 +84,14 @@ class _PlannerSchema(BaseModel):
     small_objects: bool | None = None
     grasp_height: (Literal["clearance", "auto"]
                    | Annotated[float, Field(ge=0, le=tol.MAX_HAND_SIZE, allow_inf_nan=False)] | None) = None
+
+    @field_validator("grasp_height", mode="before")
+    @classmethod
+    def _height(cls, value):
+        """A number is a height: say so when it is out of range, rather than that it is no rule's name."""
+        if isinstance(value, (int, float)) and not isinstance(value, bool) and not 0 <= value <= tol.MAX_HAND_SIZE:
+            raise ValueError(f"a grasp height must be in [0, {tol.MAX_HAND_SIZE:g}] m, got {value!r}")
+        return float(value) if isinstance(value, int) and not isinstance(value, bool) else value
 
     @model_validator(mode="after")
     def _grid_size(self):
