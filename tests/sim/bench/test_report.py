@@ -135,3 +135,11 @@ def test_a_bin_bench_reports_its_scene_and_the_hit_cause(tmp_path, capsys):
     assert "Scene `bin`: 1-3 objects in a bin" in table and "| hit a neighbour or the bin |" in table
     assert "without the hand touching a neighbour or a bin wall" in table
     assert [r["object"] for r in json.loads((out / "trials.json").read_text())] == ["can", "stone2"]
+
+
+def test_the_reports_first_paragraph_says_how_the_hand_is_simulated():
+    from contourgrasp.sim.bench.report import _trials_text
+
+    bench = Bench(objects=thesis_objects(["can"]), planners=("paper",), trials=1)
+    text = _trials_text(bench, 1, 1.0, 0)
+    assert "Hand `five-finger-linear` (one tendon, the thesis's finger timing); depth noise on" in text

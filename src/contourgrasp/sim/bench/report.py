@@ -167,7 +167,8 @@ def _success_text(bench: Bench) -> str:
 def _trials_text(bench: Bench, n_trials: int, wall_time: float, kept: int) -> str:
     resumed = f" ({kept} of them run earlier and kept by --resume)" if kept else ""
     return (f"{len(bench.objects)} object(s) x {bench.trials} trial(s) x {len(bench.planners)} planner(s) = "
-            f"{n_trials} trials in {wall_time:.0f} s wall time{resumed}. Hand `{bench.hand.name}` X; depth noise {'on' if bench.noise else 'off'}; trial t uses seed {bench.seed} "
+            f"{n_trials} trials in {wall_time:.0f} s wall time{resumed}. Hand `{bench.hand.name}` ({_simulated(bench)}"
+            f"); depth noise {'on' if bench.noise else 'off'}; trial t uses seed {bench.seed} "
             f"+ t, the same scene for every planner.{_scene_text(bench)}")
 
 
