@@ -311,3 +311,13 @@ def test_cli_plan_all_writes_all_or_nothing(tmp_path, capsys):
     assert main([*args, "--all", "--out", str(tmp_path / "plan.json")]) == 2
     assert "plan_3.json: cannot write, it is a directory" in capsys.readouterr().err
     assert not (tmp_path / "plan_2.json").exists()
+
+
+def test_a_pixel_on_an_object_inside_a_bins_walls_is_the_object_not_the_bin():
+    """The walls' ring, its hole filled, covers the objects in the bin too: the innermost candidate wins."""
+    walls = [(150, 100, 300, 10, 0.10), (150, 300, 300, 10, 0.10), (150, 100, 10, 210, 0.10), (440, 100, 10, 210, 0.10)]
+    found = candidates(scene(*walls, (270, 180, 60, 40, 0.05)))
+    target, _ = choose_target(found, target_px=(300, 200))
+    assert target.bbox == (270, 180, 60, 40)
+    ring, _ = choose_target(found, target_px=(155, 200))
+    assert ring.bbox == (150, 100, 300, 210)

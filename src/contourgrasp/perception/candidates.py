@@ -275,8 +275,9 @@ def check_roi(roi, shape=None) -> tuple[int, int, int, int]:
 
 
 def _at_pixel(candidates, pixel, shape):
+    """The innermost candidate under the pixel: an object in a bin lies inside the walls' filled ring too."""
     u, v = pixel
-    for c in candidates:
+    for c in sorted(candidates, key=lambda c: int(c.mask.sum())):
         if c.mask[v, u]:
             if not c.in_view:
                 raise SegmentationError(
