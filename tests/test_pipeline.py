@@ -9,6 +9,7 @@ import pytest
 
 import contourgrasp as cg
 from contourgrasp import pipeline
+from contourgrasp import tolerances as tol
 from contourgrasp.cli import main
 from contourgrasp.io.camera_file import read_extrinsics, read_intrinsics, read_mask, read_rgbd
 from contourgrasp.io.plan_file import image_plan_to_dict
@@ -372,7 +373,8 @@ def test_a_3d_plan_descends_clear_and_puts_the_palm_at_the_grasp_height(standing
     assert check.feasible[0] and check.clearance.min() >= check.margin - 1e-9
     assert result.grasp_height == check.tip_height[0]
     top = result.height_map.max_height
-    assert 0.5 * top - 0.01 <= result.grasp_height <= 0.7 * top + 1e-9  # the auto rule, for a 12 cm can
+    low, high = tol.GRASP_HEIGHT_FRACTION * top, tol.MAX_GRASP_HEIGHT_FRACTION * top  # the auto rule, a 12 cm can
+    assert low - 1e-9 <= result.grasp_height <= high + 1e-9
     palm = result.metric.to_camera([result.plan.pose[:2]], depth=result.T_camera_hand[:3, 3] @ result.metric.R_camera_plane[:, 2])
     np.testing.assert_allclose(palm[0], result.T_camera_hand[:3, 3], atol=1e-9)
     planning = result.metric.R_camera_plane.T @ (result.T_camera_hand[:3, 3] - result.metric.origin)

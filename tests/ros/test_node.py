@@ -255,8 +255,10 @@ def test_the_ros_command_serves_plan_and_stops_on_ctrl_c(ros):
     try:
         assert camera.call().message.startswith("no frame yet")
         process.send_signal(signal.SIGINT)
-        assert process.wait(timeout=TIMEOUT) == 0
-        assert "Traceback" not in process.stderr.read()
+        code = process.wait(timeout=TIMEOUT)
+        stderr = process.stderr.read()
+        assert code == 0, stderr
+        assert "Traceback" not in stderr
     finally:
         if process.poll() is None:
             process.kill()

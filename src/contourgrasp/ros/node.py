@@ -19,6 +19,8 @@ T_camera_pregrasp in the image's frame, at its stamp) and ``~/markers``
 
 from __future__ import annotations
 
+import contextlib
+
 import json
 import math
 import time
@@ -278,6 +280,9 @@ def main(ros_args=()) -> int:
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
+        # A Ctrl-C may land while the node is being torn down (rclpy's handler and Python's both see it):
+        # the shutdown it asks for is under way, so it is not an error.
+        with contextlib.suppress(KeyboardInterrupt, ExternalShutdownException):
+            node.destroy_node()
+            rclpy.try_shutdown()
     return 0
