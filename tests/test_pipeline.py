@@ -429,3 +429,14 @@ def test_the_3d_plan_figure_shows_each_fingers_plane(standing_can_frame):
     assert any("each finger's plane" in t and "least clearance" in t for t in titles)
     flat = pipeline.plan_frame(rgb, depth, K, cg.load_hand("five-finger-linear"), yaw_step=0.1)
     assert not any("each finger's plane" in ax.get_title() for ax in image_plan_figure(flat, rgb).axes)
+
+
+@pytest.mark.parametrize("options, message", [
+    ({"grasp_height": "high"}, "grasp_height"), ({"grasp_height": -1.0}, "grasp_height"),
+    ({"descent": "yes"}, "descent"), ({"slice_contour": 1}, "slice_contour"),
+    ({"closing_sweep": "no"}, "closing_sweep"), ({"small_objects": None}, "small_objects"),
+])
+def test_bad_3d_options_are_refused_by_name_even_for_a_2d_hand(standing_can_frame, options, message):
+    rgb, depth, K = standing_can_frame
+    with pytest.raises(cg.errors.PlannerError, match=message):
+        pipeline.plan_frame(rgb, depth, K, cg.load_hand("five-finger-curved-thumb"), yaw_step=0.3, **options)
