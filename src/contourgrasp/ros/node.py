@@ -19,10 +19,9 @@ T_camera_pregrasp in the image's frame, at its stamp) and ``~/markers``
 
 from __future__ import annotations
 
-import contextlib
-
 import json
 import math
+import signal
 import time
 import warnings
 from dataclasses import dataclass, field, replace
@@ -280,9 +279,19 @@ def main(ros_args=()) -> int:
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
-        # A Ctrl-C may land while the node is being torn down (rclpy's handler and Python's both see it):
-        # the shutdown it asks for is under way, so it is not an error.
-        with contextlib.suppress(KeyboardInterrupt, ExternalShutdownException):
-            node.destroy_node()
-            rclpy.try_shutdown()
+        _ignore_interrupts()
+        node.destroy_node()
+        rclpy.try_shutdown()
     return 0
+
+
+def _ignore_interrupts() -> None:
+    """Ignore SIGINT from here on: rclpy's handler passes a Ctrl-C on to Python's, whose KeyboardInterrupt may
+    land after the spin has already stopped on it and cut the teardown short (the process then hangs at exit
+    on a context never shut down). A Python handler not yet run when SIG_IGN is set is not run at all."""
+    while True:
+        try:
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+            return
+        except KeyboardInterrupt:
+            continue
