@@ -378,6 +378,8 @@ def _perceive(rgb, depth, intrinsics, *, segment, mask, depth_mode, footprint, f
         seg = perception.segment_from_mask(mask)
     else:
         options = {"footprint": False if depth_mode == "plane" else footprint}
+        if fill_holes:
+            options["fill_holes"] = False  # d is filled already: a second pass finds the same larger holes only
         if plane is not None and segment != "rgb":
             options["plane"] = plane  # the same fit segmentation would make
         if target is not None and (chosen or target is not next(c for c in candidates if c.in_view)):
