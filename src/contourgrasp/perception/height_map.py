@@ -239,11 +239,16 @@ class HeightMap:
         span = min(float(np.hypot(*self.shape)) * self.cell, float(reach.max()))
         steps = np.arange(1, int(math.ceil(2 * span / self.cell)) + 1) * (0.5 * self.cell)  # half cells: no cell skipped
         bound = np.empty(len(rows))
+        ny, nx = self.shape
         for a in range(0, len(rows), _WALK_BATCH):
             sl = slice(a, a + _WALK_BATCH)
             s = np.minimum(steps[None, :], reach[sl, None])
-            points = start[sl, None, :] + s[..., None] * unit[sl, None, :]
-            h = self.at(points.reshape(-1, 2)).reshape(s.shape)
+            # The cells of the walk's points (finite, so cell_index's NaN handling is not needed here).
+            col = np.floor((start[sl, None, 0] + s * unit[sl, None, 0] - self.origin[0]) / self.cell)
+            row = np.floor((start[sl, None, 1] + s * unit[sl, None, 1] - self.origin[1]) / self.cell)
+            inside = (col >= 0) & (col < nx) & (row >= 0) & (row < ny)
+            h = np.where(inside, self.heights[np.clip(row, 0, ny - 1).astype(np.intp),
+                                              np.clip(col, 0, nx - 1).astype(np.intp)], np.nan)
             # The occluder's point and the cell's surface may lie anywhere in their cells: the bound takes
             # them a cell's diagonal nearer each other (which only raises it).
             gap = np.maximum(s - diagonal, 0.0)
