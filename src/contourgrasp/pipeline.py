@@ -32,10 +32,10 @@ from .hand import Hand
 from .perception import HeightMap, Intrinsics, MetricContour, Plane, Segmentation
 from .perception.camera import check_intrinsics
 from .synthesis import Descent, GraspPlan, search
-from .synthesis.grasp_height import GRASP_HEIGHT_RULES
+from .synthesis.grasp_height import check_rule as check_grasp_height
 from .synthesis.grasp_height import grasp_height as choose_grasp_height
-from .tolerances import (APPROACH_OFFSET, HOMOGENEOUS_ROW, MAX_APPROACH_OFFSET, MAX_HAND_SIZE, MAX_STANDOFF,
-                         ROTATION_TOLERANCE, SMALL_OBJECT_TOUCHING)
+from .tolerances import (APPROACH_OFFSET, HOMOGENEOUS_ROW, MAX_APPROACH_OFFSET, MAX_STANDOFF, ROTATION_TOLERANCE,
+                         SMALL_OBJECT_TOUCHING)
 
 SEGMENT_CHOICES = perception.SEGMENT_METHODS
 
@@ -268,10 +268,8 @@ def _grasp_height(hand: Hand, heights: HeightMap | None, descent, grasp_height) 
     """The grasp height asked for and the highest accepted, for :func:`plan_frame`'s options; None: not
     planned (a 2-D hand, no table). A bad ``grasp_height`` is refused whether or not it could be used."""
     descent = validation.flag("descent", descent, error=PlannerError)
-    if isinstance(grasp_height, str):
-        validation.choice("grasp_height", grasp_height, GRASP_HEIGHT_RULES, error=PlannerError)
-    elif grasp_height is not None:
-        validation.bounded("grasp_height", grasp_height, MAX_HAND_SIZE, " m", error=PlannerError)
+    if grasp_height is not None:
+        check_grasp_height(grasp_height)
     if grasp_height is None and not descent:
         return None
     if not hand.is_3d or heights is None:

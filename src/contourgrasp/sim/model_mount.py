@@ -63,6 +63,11 @@ class MountedHand:
     def tip_depth(self) -> float:
         return self.derivation.mount.tip_depth
 
+    @property
+    def open_tip_depth(self) -> float | None:
+        """The derived hand file's open-tip depth (None for a 2-D file: no planned grasp height to execute)."""
+        return self.hand.open_tip_depth
+
     @cached_property
     def _geom_plan(self) -> tuple[tuple[int, str], ...]:
         """(index in the model's geoms, name in the scene) of every collision geom."""

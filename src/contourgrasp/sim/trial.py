@@ -299,7 +299,7 @@ def execute_grasp(scene: Scene, transform, approach_depth: float, execution: Exe
         lowest = max(f.radius for f in scene.hand.fingers) + execution.tip_clearance
         palm_final = max(scene.hand.tip_depth + lowest, top + execution.palm_clearance)
     else:
-        depth = getattr(scene.hand, "open_tip_depth", None)
+        depth = scene.hand.open_tip_depth
         if depth is None:
             raise SimulationError(f"the simulated hand {scene.hand.hand.name!r} has no open fingertip depth: "
                                   "it cannot execute a planned grasp height")

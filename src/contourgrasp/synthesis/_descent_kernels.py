@@ -1,4 +1,5 @@
-"""Compiled descent clearances (numba): the one user is :func:`contourgrasp.synthesis.descent.descent_clearance`.
+"""Compiled descent clearances (numba), for :func:`contourgrasp.synthesis.descent.descent_clearance` and the closing
+sweep (:func:`contourgrasp.synthesis.sweep.link_first`), both through :func:`map_clearances`.
 
 Per pose and body the kernel walks the cells of the body's footprint's bounding box and keeps the
 least gap between the body's lowest point over a cell's centre line and the cell's height (the
@@ -13,6 +14,21 @@ import math
 
 import numpy as np
 from numba import njit
+
+from ..tolerances import VERTICAL_AXIS
+
+
+def map_clearances(heights, hand, poses, base, ends, radii) -> np.ndarray:
+    """(p, n + 1) float: the least gap over ``heights`` (a HeightMap's conservative layer) of each capsule
+    (``ends`` (n, 2, 3), ``radii`` (n,), hand frame) and of ``hand``'s palm, per pose (p, 3) with its height
+    offset ``base`` (p,)."""
+    out = np.empty((len(poses), len(ends) + 1))
+    clearances(np.ascontiguousarray(heights.conservative(), dtype=float), np.asarray(heights.origin, dtype=float),
+               float(heights.cell), np.asarray(heights.table_normal, dtype=float), np.ascontiguousarray(poses, dtype=float),
+               np.ascontiguousarray(base, dtype=float), np.ascontiguousarray(ends, dtype=float),
+               np.ascontiguousarray(radii, dtype=float), np.ascontiguousarray(hand.palm.points, dtype=float),
+               VERTICAL_AXIS, out)
+    return out
 
 
 @njit(cache=True)

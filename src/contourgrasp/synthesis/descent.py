@@ -81,8 +81,8 @@ from .. import validation
 from ..errors import HandError, PerceptionError, PlannerError
 from ..hand import Hand, chain_capsules, chain_tip
 from ..perception.height_map import HeightMap
-from ..tolerances import DESCENT_BATCH, DESCENT_MARGIN, MAX_DESCENT_POSES, MAX_HAND_SIZE, VERTICAL_AXIS
-from ._descent_kernels import clearances
+from ..tolerances import DESCENT_BATCH, DESCENT_MARGIN, MAX_DESCENT_POSES, MAX_HAND_SIZE
+from ._descent_kernels import map_clearances
 from .sweep import link_first
 
 #: Parts of a finger's chain, in the order of :func:`~contourgrasp.hand.chain_capsules`.
@@ -216,14 +216,10 @@ def descent_clearance(hand: Hand, heights: HeightMap, poses, tip_height) -> np.n
     """
     _check_hand(hand)
     poses, tip, normal = _check_inputs(heights, poses, tip_height)
-    ends = np.ascontiguousarray(np.concatenate([chain_capsules(c, 0.0)[0] for c in hand.chains]))  # (3n, 2, 3)
+    ends = np.concatenate([chain_capsules(c, 0.0)[0] for c in hand.chains])  # (3n, 2, 3)
     radii = np.repeat([c.radius for c in hand.chains], 3).astype(float)
     base = height_base(hand, poses, tip, normal)
-    out = np.empty((len(poses), len(ends) + 1))
-    clearances(np.ascontiguousarray(heights.conservative(), dtype=float), np.asarray(heights.origin, dtype=float),
-               float(heights.cell), normal, poses, base, ends, radii,
-               np.ascontiguousarray(hand.palm.points, dtype=float), VERTICAL_AXIS, out)
-    return out
+    return map_clearances(heights, hand, poses, base, ends, radii)
 
 
 def height_base(hand: Hand, poses, tip_height, normal) -> np.ndarray:

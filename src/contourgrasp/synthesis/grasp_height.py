@@ -34,6 +34,19 @@ from ..perception.height_map import HeightMap
 GRASP_HEIGHT_RULES = ("clearance", "auto")
 
 
+def check_rule(rule):
+    """``rule`` if it names a rule of :data:`GRASP_HEIGHT_RULES` or is a height in [0, ``MAX_HAND_SIZE``] m (as a float).
+
+    Raises
+    ------
+    PlannerError
+        Anything else, naming ``grasp_height``.
+    """
+    if isinstance(rule, str):
+        return validation.choice("grasp_height", rule, GRASP_HEIGHT_RULES, error=PlannerError)
+    return validation.bounded("grasp_height", rule, tol.MAX_HAND_SIZE, " m", error=PlannerError)
+
+
 def grasp_height(hand: Hand, heights: HeightMap, rule: str | float = "auto") -> tuple[float, float]:
     """The grasp height asked for and the highest accepted: the open hand's lowest fingertip above the table, m.
 
@@ -55,10 +68,9 @@ def grasp_height(hand: Hand, heights: HeightMap, rule: str | float = "auto") -> 
     PlannerError
         Unknown rule, or a height that is not a finite number in [0, ``MAX_HAND_SIZE``].
     """
+    rule = check_rule(rule)
     if not isinstance(rule, str):
-        height = validation.bounded("grasp_height", rule, tol.MAX_HAND_SIZE, " m", error=PlannerError)
-        return height, height
-    validation.choice("grasp_height", rule, GRASP_HEIGHT_RULES, error=PlannerError)
+        return rule, rule
     top = float(heights.max_height) if math.isfinite(heights.max_height) else 0.0
     swing = hand.closing_tip_depth - hand.open_tip_depth
     floor = max(c.radius for c in hand.chains) + tol.GRASP_TIP_CLEARANCE + swing

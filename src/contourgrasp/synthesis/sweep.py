@@ -29,7 +29,7 @@ import numpy as np
 from .. import tolerances as tol
 from ..hand import FingerChain, Hand, chain_capsules, chain_tip
 from ..perception.height_map import HeightMap
-from ._descent_kernels import clearances
+from ._descent_kernels import map_clearances
 
 
 @lru_cache(maxsize=64)
@@ -75,12 +75,8 @@ def link_first(hand: Hand, heights: HeightMap, pose, base: float, lam, touching)
     early = np.zeros(len(hand.chains), dtype=bool)
     if not ends:
         return early
-    ends = np.ascontiguousarray(np.concatenate(ends))
+    ends = np.concatenate(ends)
     radii = np.array([hand.chains[f].radius for f in owner], dtype=float)
-    out = np.empty((1, len(ends) + 1))
-    clearances(np.ascontiguousarray(heights.conservative(), dtype=float), np.asarray(heights.origin, dtype=float),
-               float(heights.cell), np.asarray(heights.table_normal, dtype=float), np.asarray(pose, dtype=float)[None],
-               np.array([base], dtype=float), ends, radii, np.ascontiguousarray(hand.palm.points, dtype=float),
-               tol.VERTICAL_AXIS, out)
+    out = map_clearances(heights, hand, np.asarray(pose, dtype=float)[None], np.array([base], dtype=float), ends, radii)
     np.logical_or.at(early, np.asarray(owner), out[0, :-1] < 0.0)
     return early
