@@ -5,7 +5,7 @@ import pytest
 
 from contourgrasp import load_hand
 from contourgrasp import tolerances as tol
-from contourgrasp.errors import PlannerError
+from contourgrasp.errors import NoFeasibleGrasp, PlannerError
 from contourgrasp.perception import HeightMap
 from contourgrasp.synthesis.grasp_height import grasp_height
 
@@ -43,6 +43,8 @@ def test_auto_asks_a_fraction_of_the_height_and_accepts_up_to_a_larger_one(hand)
 
 def test_a_number_is_the_height_itself_and_bad_rules_are_refused(hand):
     assert grasp_height(hand, with_top(0.1), 0.05) == (0.05, 0.05)
+    with pytest.raises(NoFeasibleGrasp, match="a grasp height of 100 mm is not below the object's top"):
+        grasp_height(hand, with_top(0.1), 0.1)
     for bad in ("high", -0.01, np.nan, 1e9):
         with pytest.raises(PlannerError, match="grasp_height"):
             grasp_height(hand, with_top(0.1), bad)

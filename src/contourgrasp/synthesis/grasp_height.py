@@ -26,7 +26,7 @@ import math
 
 from .. import tolerances as tol
 from .. import validation
-from ..errors import PlannerError
+from ..errors import NoFeasibleGrasp, PlannerError
 from ..hand import Hand
 from ..perception.height_map import HeightMap
 
@@ -67,11 +67,16 @@ def grasp_height(hand: Hand, heights: HeightMap, rule: str | float = "auto") -> 
     ------
     PlannerError
         Unknown rule, or a height that is not a finite number in [0, ``MAX_HAND_SIZE``].
+    NoFeasibleGrasp
+        A height given as a number that is not below the object's top.
     """
     rule = check_rule(rule)
-    if not isinstance(rule, str):
-        return rule, rule
     top = float(heights.max_height) if math.isfinite(heights.max_height) else 0.0
+    if not isinstance(rule, str):
+        if math.isfinite(heights.max_height) and rule >= top:
+            raise NoFeasibleGrasp(f"a grasp height of {1000 * rule:.0f} mm is not below the object's top "
+                                  f"({1000 * top:.0f} mm): the fingertips would close over it")
+        return rule, rule
     swing = hand.closing_tip_depth - hand.open_tip_depth
     floor = max(c.radius for c in hand.chains) + tol.GRASP_TIP_CLEARANCE + swing
     height = max(floor, top + tol.GRASP_PALM_CLEARANCE - hand.open_tip_depth)
