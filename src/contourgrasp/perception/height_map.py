@@ -211,11 +211,11 @@ class HeightMap:
         (ny, nx) float
             No NaN; +inf outside the view. Computed once per map and read-only.
         """
-        cached = self.__dict__.get("_conservative")
+        cached = self.__dict__.get("_conservative_layer")  # not "_conservative": that is the method computing it
         if cached is None:
             cached = self._conservative()
             cached.flags.writeable = False
-            object.__setattr__(self, "_conservative", cached)
+            object.__setattr__(self, "_conservative_layer", cached)
         return cached
 
     def _conservative(self) -> np.ndarray:
