@@ -434,7 +434,7 @@ def test_the_3d_plan_figure_shows_each_fingers_plane(standing_can_frame):
 @pytest.mark.parametrize("options, message", [
     ({"grasp_height": "high"}, "grasp_height"), ({"grasp_height": -1.0}, "grasp_height"),
     ({"descent": "yes"}, "descent"), ({"slice_contour": 1}, "slice_contour"),
-    ({"closing_sweep": "no"}, "closing_sweep"), ({"small_objects": None}, "small_objects"),
+    ({"closing_sweep": "no"}, "closing_sweep"), ({"closing_obstacles": 1}, "closing_obstacles"), ({"small_objects": None}, "small_objects"),
 ])
 def test_bad_3d_options_are_refused_by_name_even_for_a_2d_hand(standing_can_frame, options, message):
     rgb, depth, K = standing_can_frame

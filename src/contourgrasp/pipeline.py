@@ -121,6 +121,7 @@ def plan_frame(
     grasp_height: str | float | None = None,
     slice_contour: bool = False,
     closing_sweep: bool = False,
+    closing_obstacles: bool = False,
     small_objects: bool = False,
     **synthesis_options,
 ) -> ImageGraspPlan:
@@ -191,6 +192,10 @@ def plan_frame(
     closing_sweep : bool
         With ``descent``: also refuse a pose where a touching finger's chain would meet the scene
         before its tip reaches its grasp point (:mod:`contourgrasp.synthesis.sweep`).
+    closing_obstacles : bool
+        With ``descent``: also refuse a pose where a finger, closing until it meets the target (or to
+        its end, if it misses), would run into a neighbouring object or a bin's wall -- the height
+        map's obstacle cells (:func:`contourgrasp.synthesis.sweep.closing_hits`).
     small_objects : bool
         The small-object rule: when no pose satisfies the constraints with the hand's
         ``min_touching`` fingers, plan again with fewer touching fingers, down to
@@ -229,7 +234,8 @@ def plan_frame(
     heights = scene_heights(d, intrinsics, seg, metric, plane=table)
     asked = _grasp_height(hand, heights, descent, grasp_height)
     sweep = validation.flag("closing_sweep", closing_sweep, error=PlannerError)
-    spec = Descent(heights, *asked, sweep=sweep) if descent and asked is not None else None
+    closing = validation.flag("closing_obstacles", closing_obstacles, error=PlannerError)
+    spec = Descent(heights, *asked, sweep=sweep, closing=closing) if descent and asked is not None else None
     contour = metric.contour_xy
     if validation.flag("slice_contour", slice_contour, error=PlannerError) and asked is not None:
         section = perception.cross_section(heights, asked[0])

@@ -274,3 +274,22 @@ def test_a_pose_blocked_only_by_a_neighbour_says_so(hand):
     heights = replace(heights, object=heights.heights == 0.05, obstacles=heights.heights == 0.15)
     with pytest.raises(NoFeasibleGrasp, match="blocked by a neighbouring object or the bin wall"):
         synthesis.search(contour, hand, descent=Descent(heights, 0.02, 0.02), xy_step=0.01, yaw_step=math.radians(8))
+
+
+def test_a_low_ring_the_closing_fingers_would_cross_blocks_every_pose_and_says_so(hand):
+    """A 5 cm column ringed 2 cm away by a 15 mm kerb: the open hand descends clear outside the kerb, but every
+    finger closing from there runs through it, lower than the tips' balls (11 mm above the table)."""
+    from contourgrasp import synthesis
+
+    r = 0.05
+    contour = np.c_[r * np.cos(np.linspace(0, 2 * np.pi, 200, endpoint=False)),
+                    r * np.sin(np.linspace(0, 2 * np.pi, 200, endpoint=False))]
+    kerb = lambda x, y: (np.hypot(x, y) > r + 0.02) & (np.hypot(x, y) < r + 0.025)  # noqa: E731
+    heights = scene(lambda x, y: np.where(np.hypot(x, y) <= r, 0.05, np.where(kerb(x, y), 0.015, 0.0)))
+    heights = replace(heights, object=heights.heights == 0.05, obstacles=heights.heights == 0.015)
+    options = dict(xy_step=0.01, yaw_step=math.radians(8))
+    plan = synthesis.search(contour, hand, descent=Descent(heights, 0.02, 0.02), **options)
+    assert plan.descent.feasible[0]  # without the closing check the hand would close through the kerb
+    with pytest.raises(NoFeasibleGrasp, match="blocked by a neighbouring object or the bin wall: .* would run a "
+                                              "finger into a neighbouring object or the bin wall while the hand closes"):
+        synthesis.search(contour, hand, descent=Descent(heights, 0.02, 0.02, closing=True), **options)

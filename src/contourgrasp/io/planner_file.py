@@ -28,6 +28,7 @@ which is the thesis's setting)::
     grasp_height = "clearance"   # or "auto", or a height in m (synthesis.grasp_height)
     slice_contour = false        # plan on the cross-section at the grasp height (perception.cross_section)
     closing_sweep = false        # refuse poses where a finger's link meets the object before its tip (synthesis.sweep)
+    closing_obstacles = false    # refuse poses where a closing finger runs into a neighbour or a bin wall
     small_objects = false        # fewer touching fingers where no pose brings min_touching onto the object
 
 Unknown keys, wrong types and impossible values are refused with
@@ -52,7 +53,7 @@ _PRESET_DIR = "data/planners"
 #: Options that belong to perception, and to planning in the scene's 3-D (the rest are
 #: :func:`contourgrasp.synthesis.search`'s).
 PERCEPTION_OPTIONS = ("depth_mode", "footprint")
-SCENE_OPTIONS = ("descent", "grasp_height", "slice_contour", "closing_sweep", "small_objects")
+SCENE_OPTIONS = ("descent", "grasp_height", "slice_contour", "closing_sweep", "closing_obstacles", "small_objects")
 
 Positive = Annotated[float, Field(gt=0, le=tol.MAX_SEARCH_LENGTH, allow_inf_nan=False)]
 Distance = Annotated[float, Field(ge=0, le=tol.MAX_SEARCH_LENGTH, allow_inf_nan=False)]
@@ -81,6 +82,7 @@ class _PlannerSchema(BaseModel):
     descent: bool | None = None
     slice_contour: bool | None = None
     closing_sweep: bool | None = None
+    closing_obstacles: bool | None = None
     small_objects: bool | None = None
     grasp_height: (Literal["clearance", "auto"]
                    | Annotated[float, Field(ge=0, le=tol.MAX_HAND_SIZE, allow_inf_nan=False)] | None) = None

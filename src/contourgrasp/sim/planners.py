@@ -65,6 +65,7 @@ ABLATION_STEPS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("slice", ("slice_contour",)),
     ("sweep", ("closing_sweep",)),
     ("small", ("small_objects",)),
+    ("closing", ("closing_obstacles",)),
 )
 #: Baseline planners without synthesis: name -> what it does (module docstring).
 BASELINES = {

@@ -83,7 +83,7 @@ from ..hand import Hand, chain_capsules, chain_tip
 from ..perception.height_map import HeightMap
 from ..tolerances import DESCENT_BATCH, DESCENT_MARGIN, MAX_DESCENT_POSES, MAX_HAND_SIZE
 from ._descent_kernels import map_clearances
-from .sweep import link_first
+from .sweep import closing_hits, link_first, obstacle_map
 
 #: Parts of a finger's chain, in the order of :func:`~contourgrasp.hand.chain_capsules`.
 FINGER_PARTS = ("post", "proximal", "distal")
@@ -159,6 +159,9 @@ class Descent:
     sweep : bool
         Also refuse a pose where a touching finger's chain meets the scene before its tip reaches
         its grasp point (:func:`~contourgrasp.synthesis.sweep.link_first`).
+    closing : bool
+        Also refuse a pose where a finger's chain, closing, runs into one of the map's obstacles -- a
+        neighbouring object, a bin's wall (:func:`~contourgrasp.synthesis.sweep.closing_hits`).
     """
 
     heights: HeightMap
@@ -166,6 +169,7 @@ class Descent:
     max_tip_height: float
     margin: float = DESCENT_MARGIN
     sweep: bool = False
+    closing: bool = False
 
     def __post_init__(self):
         if not isinstance(self.heights, HeightMap):
@@ -176,6 +180,7 @@ class Descent:
             raise PlannerError(f"max_tip_height ({self.max_tip_height:g} m) is below tip_height ({self.tip_height:g} m)")
         validation.bounded("margin", self.margin, MAX_HAND_SIZE, " m", error=PlannerError)
         validation.flag("sweep", self.sweep, error=PlannerError)
+        validation.flag("closing", self.closing, error=PlannerError)
 
 
 def body_names(hand: Hand) -> tuple[str, ...]:
@@ -284,37 +289,52 @@ def check_candidates(hand: Hand, descent: Descent, poses, order, lam=None,
     order : (m,) int
         Indices into ``poses`` to check, best first.
     lam, touching : (p, f) float and bool, optional
-        The poses' inner problem (:class:`~contourgrasp.synthesis.PoseEvaluation`), for ``descent.sweep``.
+        The poses' inner problem (:class:`~contourgrasp.synthesis.PoseEvaluation`), for ``descent.sweep``
+        and ``descent.closing``.
 
     Returns
     -------
     passed : (p,) bool
         True for the checked poses whose hand descends clear to a grasp height at most
-        ``descent.max_tip_height``; every pose not checked is False.
+        ``descent.max_tip_height`` (and closes clear, with ``descent.sweep`` or ``descent.closing``);
+        every pose not checked is False.
     tip_height : (p,) float
         The grasp height of each checked pose: ``descent.tip_height``, or higher where a body needs it
         (NaN where not checked).
     last : DescentCheck or None
-        The check of the last batch at ``descent.tip_height`` (for the reason none passed); None when
-        ``order`` is empty.
+        The check at ``descent.tip_height`` of the last batch in which some pose descended clear
+        (:func:`descends_clear`: a closing check refused it), else of the last batch -- for the
+        reason none passed; None when ``order`` is empty.
 
     At most ``tolerances.MAX_DESCENT_POSES`` poses are checked.
     """
     passed = np.zeros(len(poses), dtype=bool)
     tip = np.full(len(poses), np.nan)
-    last = None
+    last = cleared = None
     order = np.asarray(order, dtype=np.intp)[:MAX_DESCENT_POSES]
+    obstacles = obstacle_map(descent.heights) if descent.closing and descent.heights.obstacles.any() else None
     for a in range(0, len(order), DESCENT_BATCH):
         rows = order[a:a + DESCENT_BATCH]
         last = descent_feasible(hand, descent.heights, poses[rows], descent.tip_height, margin=descent.margin)
         raised = descent.tip_height + np.maximum(descent.margin - last.clearance.min(axis=1), 0.0)
         tip[rows] = raised
         passed[rows] = raised <= descent.max_tip_height
+        cleared = last if passed[rows].any() else cleared
         if descent.sweep and lam is not None:
-            passed[rows] &= ~_links_first(hand, descent.heights, poses[rows], raised, lam[rows], touching[rows])
+            passed[rows] &= ~_swept(link_first, hand, descent.heights, poses[rows], raised, lam[rows], touching[rows])
+        if obstacles is not None and lam is not None:
+            passed[rows] &= ~_swept(closing_hits, hand, obstacles, poses[rows], raised, lam[rows], touching[rows])
         if passed[rows].any():
             break
-    return passed, tip, last
+    return passed, tip, cleared or last
+
+
+def descends_clear(descent: Descent, check: DescentCheck | None) -> bool:
+    """Whether some pose of ``check`` descends clear within ``descent.max_tip_height`` (raised where it must be)."""
+    if check is None:
+        return False
+    raised = check.tip_height + np.maximum(check.margin - check.clearance.min(axis=1), 0.0)
+    return bool((raised <= descent.max_tip_height).any())
 
 
 def blocked_by_obstacles(hand: Hand, descent: Descent, check: DescentCheck) -> bool:
@@ -328,10 +348,10 @@ def blocked_by_obstacles(hand: Hand, descent: Descent, check: DescentCheck) -> b
     return bool(descent_feasible(hand, bare, check.poses, tip, margin=descent.margin).feasible.any())
 
 
-def _links_first(hand, heights, poses, tip, lam, touching) -> np.ndarray:
-    """(p,) bool: a touching finger's chain meets the map before its tip's grasp point (:func:`link_first`)."""
+def _swept(check, hand, heights, poses, tip, lam, touching) -> np.ndarray:
+    """(p,) bool: some finger fails a closing-sweep ``check`` (:func:`link_first`, :func:`closing_hits`) per pose."""
     base = height_base(hand, poses, tip, np.asarray(heights.table_normal, dtype=float))
-    return np.array([link_first(hand, heights, pose, b, l, t).any()
+    return np.array([check(hand, heights, pose, b, l, t).any()
                      for pose, b, l, t in zip(poses, base, lam, touching)], dtype=bool)
 
 

@@ -34,7 +34,8 @@ from ..errors import HandError, NoFeasibleGrasp, PlannerError
 from ..hand import Hand, to_image
 from ._derived import hand_arrays
 from .cost import distance
-from .descent import Descent, DescentCheck, blocked_by_obstacles, body_names, check_candidates, descent_feasible
+from .descent import (Descent, DescentCheck, blocked_by_obstacles, body_names, check_candidates, descent_feasible,
+                      descends_clear)
 from .evaluate import concatenate, evaluate_poses
 from .grid import SearchGrid, distinct_best, screen_grid
 from .inner import closest_approach
@@ -223,7 +224,7 @@ def _reevaluate_best(model, hand, screen: PoseEvaluation, n: int, curvature, d_m
             candidates = candidates[candidates >= checked]  # poses [0, checked) were checked before
             passed, _, check = check_candidates(hand, descent, result.poses, candidates, result.lam, result.touching)
             passed[:checked] = False
-            last = check or last
+            last = check if check is not None and not descends_clear(descent, last) else last
             checked, descended = min(n, len(order)), descended + min(len(candidates), tol.MAX_DESCENT_POSES)
             result = replace(result, feasible=result.feasible & passed)
         if result.feasible.any():
@@ -251,12 +252,25 @@ def _diagnose_descent(hand: Hand, check: DescentCheck, n: int, descent: Descent)
     best = int(np.argmax(check.clearance.min(axis=1)))
     limit = (f"at a grasp height of {1000 * descent.tip_height:.0f} mm" if descent.max_tip_height == descent.tip_height
              else f"at any grasp height from {1000 * descent.tip_height:.0f} to {1000 * descent.max_tip_height:.0f} mm")
+    if descends_clear(descent, check):  # a closing check refused it
+        return _diagnose_closing(descent, n)
     if blocked_by_obstacles(hand, descent, check):
         return (f"blocked by a neighbouring object or the bin wall: every one of the {n} poses checked that reach "
                 f"the object would strike another raised region of the scene while the open hand descends {limit}; "
                 f"at the clearest, {check.reason(best)}")
     return (f"every one of the {n} poses checked that reach the object would strike the scene while the open "
             f"hand descends {limit}; at the clearest, {check.reason(best)}")
+
+
+def _diagnose_closing(descent: Descent, n: int) -> str:
+    """Why poses whose open hand descends clear were refused: a closing finger's chain (:mod:`.sweep`)."""
+    closing = descent.closing and bool(descent.heights.obstacles.any())
+    hits = "run a finger into a neighbouring object or the bin wall" if closing else ""
+    early = "meet the object with a finger's link before its tip" if descent.sweep else ""
+    what = " or ".join(w for w in (hits, early) if w)
+    prefix = "blocked by a neighbouring object or the bin wall: " if closing and not descent.sweep else ""
+    return (f"{prefix}every one of the {n} poses checked that reach the object and descend clear would {what} "
+            "while the hand closes")
 
 
 def _diagnose_exact(result: PoseEvaluation, safeguards: Safeguards) -> str:

@@ -1,4 +1,4 @@
-"""Closing sweep: does each finger's chain first meet the object where the plan says its tip does? (issue 16, item 1.5)
+"""Closing sweep: what each finger's chain meets while it closes (issues 16, item 1.5, and 17).
 
 The thesis's fingertip is a point on a ray or an arc: it meets the contour after travelling
 ``lambda`` (eq 3.22). The 3-D finger is a chain of capsules that sweeps a surface while it closes,
@@ -18,10 +18,21 @@ holds still); the palm and the posts do not move relative to it.
 Reading of "the chain meets the object": any capsule of the finger below the height map of any
 raised cell, the object's or an obstacle's. A finger that misses is not checked (it closes on air in
 the plan as well).
+
+:func:`closing_hits` asks the other question of the same sweep: does a closing finger run into
+something that is *not* the target -- a neighbouring object, a bin's wall -- before it stops? Each
+finger closes until it meets the object (its tip's ball then touches the contour, about a radius
+before the tip's centre reaches its grasp point) or, if it misses, to its end; its capsules are
+sampled along that motion against :func:`obstacle_map`, the height map's obstacle cells alone. The
+open hand's descent already kept every body above the whole map, so what this adds is the motion
+in the palm plane. Unseen cells count as free here (unlike for the descent): behind the target, in
+its occlusion shadow, is where every closing finger goes, and a bound over that shadow would refuse
+every grasp.
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
 from functools import lru_cache
 
 import numpy as np
@@ -38,6 +49,29 @@ def _travel(chain: FingerChain) -> tuple[np.ndarray, np.ndarray]:
     s = np.linspace(0.0, 1.0, tol.CHAIN_SAMPLES)
     tips = chain_tip(chain, s)[:, :2]
     return s, np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(tips, axis=0), axis=1))]
+
+
+def _swept_capsules(chain: FingerChain, reach: float) -> np.ndarray:
+    """(2 m, 2, 3) float: the proximal and distal capsules at ``SWEEP_SAMPLES`` closing progresses whose tips have
+    travelled evenly from 0 to ``reach`` (m) in the palm plane."""
+    s_grid, distance = _travel(chain)
+    s = np.interp(np.linspace(0.0, reach, tol.SWEEP_SAMPLES), distance, s_grid)
+    return chain_capsules(chain, s)[:, 1:].reshape(-1, 2, 3)
+
+
+def _below_map(hand: Hand, heights: HeightMap, pose, base: float, reaches) -> np.ndarray:
+    """(f,) bool: per finger, whether its swept capsules up to ``reaches[f]`` (NaN: not checked) pass below the map."""
+    checked = [f for f, reach in enumerate(reaches) if reach > 0]
+    below = np.zeros(len(hand.chains), dtype=bool)
+    if not checked:
+        return below
+    ends = [_swept_capsules(hand.chains[f], float(reaches[f])) for f in checked]
+    owner = np.repeat(checked, [len(e) for e in ends])
+    radii = np.array([hand.chains[f].radius for f in owner], dtype=float)
+    out = map_clearances(heights, hand, np.asarray(pose, dtype=float)[None], np.array([base], dtype=float),
+                         np.concatenate(ends), radii)
+    np.logical_or.at(below, owner, out[0, :-1] < 0.0)
+    return below
 
 
 def link_first(hand: Hand, heights: HeightMap, pose, base: float, lam, touching) -> np.ndarray:
@@ -62,19 +96,50 @@ def link_first(hand: Hand, heights: HeightMap, pose, base: float, lam, touching)
     (f,) bool
         False for fingers that miss or meet the object no earlier than planned.
     """
-    ends, owner = [], []
-    for f, (chain, travelled, touches) in enumerate(zip(hand.chains, lam, touching)):
-        reach = float(travelled) - chain.radius - tol.SWEEP_TOLERANCE
-        if not touches or not reach > 0:
-            continue
-        s_grid, distance = _travel(chain)
-        s = np.interp(np.linspace(0.0, reach, tol.SWEEP_SAMPLES), distance, s_grid)
-        capsules = chain_capsules(chain, s)[:, 1:]  # (m, 2, 2, 3): proximal and distal
-        ends.append(capsules.reshape(-1, 2, 3))
-        owner += [f] * len(ends[-1])
-    early = np.zeros(len(hand.chains), dtype=bool)
-    if not ends:
-        return early
+    reaches = [float(travelled) - chain.radius - tol.SWEEP_TOLERANCE if touches else np.nan
+               for chain, travelled, touches in zip(hand.chains, lam, touching)]
+    return _below_map(hand, heights, pose, base, reaches)
+
+
+def obstacle_map(heights: HeightMap) -> HeightMap:
+    """The map of ``heights``'s obstacle cells alone: every other cell (the target, the table, unseen, out of view) 0.
+
+    Examples
+    --------
+    A map without obstacles has nothing to hit:
+
+    >>> import numpy as np
+    >>> from contourgrasp.perception import HeightMap
+    >>> m = HeightMap(np.array([[0.05, np.nan]]), 0.01, np.zeros(2), np.array([[True, False]]),
+    ...               np.zeros((1, 2), bool), 0.05, np.ones((1, 2), bool), np.array([0.0, 0.0, -1.0]), 0.7,
+    ...               np.zeros(2), 0.7)
+    >>> obstacle_map(m).heights
+    array([[0., 0.]])
+    """
+    only = np.where(heights.obstacles, np.nan_to_num(heights.heights, nan=0.0), 0.0)
+    return replace(heights, heights=only, object=np.zeros_like(heights.object),
+                   in_view=np.ones_like(heights.in_view))
+
+
+def closing_hits(hand: Hand, obstacles: HeightMap, pose, base: float, lam, touching) -> np.ndarray:
+    """(f,) bool: per finger, whether its chain runs into an obstacle while it closes (module docstring).
+
+    Parameters
+    ----------
+    hand : Hand
+        A 3-D hand.
+    obstacles : HeightMap
+        :func:`obstacle_map` of the scene's height map.
+    pose, base
+        As for :func:`link_first`.
+    lam : (f,) float
+        Each finger's planned travel to its grasp point, m (ignored where it misses).
+    touching : (f,) bool
+        A touching finger stops a radius before its grasp point; the others close to their end.
+    """
+    reaches = [float(travelled) - chain.radius if touches else float(_travel(chain)[1][-1])
+               for chain, travelled, touches in zip(hand.chains, lam, touching)]
+    return _below_map(hand, obstacles, pose, base, reaches)
     ends = np.concatenate(ends)
     radii = np.array([hand.chains[f].radius for f in owner], dtype=float)
     out = map_clearances(heights, hand, np.asarray(pose, dtype=float)[None], np.array([base], dtype=float), ends, radii)
