@@ -128,6 +128,15 @@ MAX_ALL_OBJECTS = 16
 #: Smallest object, in pixels (about 2 x 2 cm at 0.7 m with a 525 px focal length).
 MIN_AREA_PX = 200
 
+#: Candidates (perception.find_candidates): raised pixels whose depth differs from a raised 4-neighbour's by more
+#: than this (m) are the edge between two surfaces -- an object against a bin's wall -- and may split the raised
+#: region there. A steep face seen at the bench's 25 deg tilt changes by about
+#: 3 mm a pixel; an object's top against a bin wall's, by centimetres.
+CANDIDATE_DEPTH_STEP = 0.02
+#: ... but only where one piece has another at least this fraction inside its filled outline (a bin's walls around an
+#: object touching them): an object's own steps, a block on a clamp's body, leave its pieces side by side.
+ENCLOSED_FRACTION = 0.5
+
 #: A second candidate region at least this fraction of the largest's area draws a warning.
 SIMILAR_SIZE = 0.5
 

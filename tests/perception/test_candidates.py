@@ -321,3 +321,36 @@ def test_a_pixel_on_an_object_inside_a_bins_walls_is_the_object_not_the_bin():
     assert target.bbox == (270, 180, 60, 40)
     ring, _ = choose_target(found, target_px=(155, 200))
     assert ring.bbox == (150, 100, 300, 210)
+
+
+def bin_with_box():
+    """A bin's 10 cm walls (a 20 px ring around 160 x 120 px) and a 4 cm box touching the inner face of its left wall."""
+    walls = (200, 150, 200, 160, 0.10)
+    depth = scene(walls)
+    depth[170:290, 220:380] = TABLE  # the bin's floor: the table itself here
+    depth[200:260, 220:280] = TABLE - 0.04  # the box, against the left wall
+    return depth
+
+
+def test_an_object_touching_a_bin_wall_is_a_candidate_of_its_own():
+    found = candidates(bin_with_box())
+    assert len(found) == 2
+    walls, box = found
+    assert walls.area_px == 200 * 160 - 160 * 120 and box.area_px == 60 * 60
+    assert box.height == pytest.approx(0.04, abs=1e-6) and walls.height == pytest.approx(0.10, abs=1e-6)
+    target, _ = choose_target(found, target_px=(250, 230))
+    assert target is box
+
+
+def test_a_step_within_an_object_leaves_it_whole():
+    """A block 4 cm higher on a box's body (a clamp's jaw): pieces side by side, not one inside another."""
+    depth = scene((300, 200, 100, 60, 0.03))
+    depth[200:230, 300:340] = TABLE - 0.07
+    found = candidates(depth)
+    assert len(found) == 1 and found[0].area_px == 6000
+
+
+def test_planning_on_the_object_in_the_bin_takes_its_region_not_the_walls():
+    result = plan_frame(None, bin_with_box(), CAMERA, cg.load_hand("five-finger-linear"), target_px=(250, 230),
+                        segment="depth", **FAST)
+    assert result.segmentation.mask.sum() == 60 * 60

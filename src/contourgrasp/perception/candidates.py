@@ -31,7 +31,7 @@ from scipy import ndimage
 
 from .. import validation
 from ..errors import PerceptionError, SegmentationError
-from ..tolerances import MIN_AREA_PX, MIN_HEIGHT, SENSOR_RANGE, SIMILAR_SIZE
+from ..tolerances import CANDIDATE_DEPTH_STEP, ENCLOSED_FRACTION, MIN_AREA_PX, MIN_HEIGHT, SENSOR_RANGE, SIMILAR_SIZE
 from .camera import Intrinsics, as_depth, check_intrinsics, valid_depth
 from .region import mask_contour, touching_regions
 from .segment_depth import raised_pixels
@@ -97,7 +97,11 @@ def find_candidates(
     speckle (:func:`~contourgrasp.perception.segment_depth.raised_pixels`,
     what :func:`~contourgrasp.perception.segment_depth.segment_depth`
     chooses from), split into 8-connected regions; those of at least
-    ``min_area_px`` pixels are the candidates.
+    ``min_area_px`` pixels are the candidates. Objects that touch in the image
+    but not in space -- an object against a bin's wall, a box before a taller
+    neighbour -- are one such region, so regions are also split where the depth
+    steps by more than ``tolerances.CANDIDATE_DEPTH_STEP`` between raised
+    4-neighbours (:func:`split_at_depth_steps`).
 
     Parameters
     ----------
@@ -127,8 +131,7 @@ def find_candidates(
     min_height = validation.positive("min_height", min_height, error=PerceptionError)
     min_area_px = validation.integer("min_area_px", min_area_px, 1, error=PerceptionError)
     above, dead_band = raised_pixels(d, intrinsics, plane, min_height=min_height, depth_range=depth_range)
-    count, labels, stats, centroids = cv2.connectedComponentsWithStats(above.astype(np.uint8), connectivity=8)
-    count -= 1
+    count, labels, stats, centroids = split_at_depth_steps(above, d, min_area_px)
     if count == 0:
         return ()
     touching = touching_regions(labels, count, dead_band)
@@ -148,6 +151,95 @@ def find_candidates(
                                (float(centroids[i, 0]), float(centroids[i, 1])), (x, y, w, hh), not bool(touching[i]),
                                _extent(contour, d[box][labels[box] == i], intrinsics)))
     return tuple(found)
+
+
+def split_at_depth_steps(above, depth, min_area_px: int):
+    """8-connected regions of ``above``, split where the depth steps by more than ``CANDIDATE_DEPTH_STEP``.
+
+    The pixels on either side of such a step between two raised 4-neighbours are cut out; the rest
+    falls into 8-connected pieces. A region is split only where one of its pieces of at least
+    ``min_area_px`` has another mostly (``ENCLOSED_FRACTION``) inside its filled outline: a bin's
+    walls around an object that touches them. An object's own steps -- a block standing on a
+    clamp's body, a lid on a box -- leave pieces side by side, and the region whole. In a split
+    region the cut pixels (and the smaller pieces) go to the nearest large piece; a region with no
+    such step is returned exactly as before.
+
+    Parameters
+    ----------
+    above : (H, W) bool
+    depth : (H, W) float
+        Depth in meters (valid wherever ``above``).
+    min_area_px : int
+
+    Returns
+    -------
+    count, labels, stats, centroids
+        As :func:`cv2.connectedComponentsWithStats` (``count`` without the background).
+
+    Examples
+    --------
+    A 10 cm ring of wall around a box 5 cm tall that touches it is two regions; the same step
+    between two surfaces side by side is one object:
+
+    >>> above = np.zeros((60, 60), bool); above[5:55, 5:55] = True; above[10:50, 10:50] = False
+    >>> above[20:40, 10:40] = True
+    >>> depth = np.full((60, 60), 0.60); depth[20:40, 10:40] = 0.65
+    >>> split_at_depth_steps(above, depth, 100)[0]
+    2
+    >>> side = np.zeros((30, 50), bool); side[5:25, 5:45] = True
+    >>> step = np.full((30, 50), 0.60); step[:, 25:] = 0.65
+    >>> split_at_depth_steps(side, step, 100)[0]
+    1
+    """
+    step = np.zeros_like(above)
+    for axis in (0, 1):
+        jump = np.abs(np.diff(depth, axis=axis)) > CANDIDATE_DEPTH_STEP
+        both = np.logical_and(np.delete(above, -1, axis), np.delete(above, 0, axis)) & jump
+        lo, hi = [slice(None)] * 2, [slice(None)] * 2
+        lo[axis], hi[axis] = slice(0, -1), slice(1, None)
+        step[tuple(lo)] |= both
+        step[tuple(hi)] |= both
+    if not step.any():
+        count, labels, stats, centroids = cv2.connectedComponentsWithStats(above.astype(np.uint8), connectivity=8)
+        return count - 1, labels, stats, centroids
+    _, regions, boxes = cv2.connectedComponentsWithStats(above.astype(np.uint8), connectivity=8)[:3]
+    _, pieces, stats = cv2.connectedComponentsWithStats((above & ~step).astype(np.uint8), connectivity=8)[:3]
+    keep = (stats[:, cv2.CC_STAT_AREA] >= min_area_px)[pieces] & (pieces > 0)
+    labels = np.where(above, pieces.max() + regions, 0)  # regions without a step stay whole
+    for region in np.unique(regions[step]):
+        x, y, w, h = boxes[region, :4]
+        box = np.s_[y:y + h, x:x + w]
+        inside, seeds = regions[box] == region, keep[box] & (regions[box] == region)
+        if _encloses(pieces[box], seeds):
+            rows, cols = ndimage.distance_transform_edt(~seeds, return_distances=False, return_indices=True)
+            labels[box][inside] = pieces[box][rows[inside], cols[inside]]
+    values = np.unique(labels[above])
+    compact = np.zeros(labels.shape, dtype=np.int32)
+    compact[above] = np.searchsorted(values, labels[above]) + 1
+    count = len(values)
+    rows, cols = np.indices(labels.shape)
+    area = np.bincount(compact.ravel(), minlength=count + 1)
+    centroids = np.stack([np.bincount(compact.ravel(), cols.ravel(), count + 1),
+                          np.bincount(compact.ravel(), rows.ravel(), count + 1)], axis=1) / np.maximum(area, 1)[:, None]
+    stats = np.zeros((count + 1, 5), dtype=np.int32)
+    for i, found in enumerate(ndimage.find_objects(compact), start=1):
+        stats[i] = (found[1].start, found[0].start, found[1].stop - found[1].start, found[0].stop - found[0].start,
+                    area[i])
+    return count, compact, stats, centroids
+
+
+def _encloses(pieces, seeds) -> bool:
+    """Whether one labelled piece of ``seeds`` (the region's large pieces) has another mostly inside its filled outline."""
+    found = np.unique(pieces[seeds])
+    if len(found) < 2:
+        return False
+    for p in found:
+        filled = ndimage.binary_fill_holes(np.pad(pieces == p, 1))[1:-1, 1:-1]
+        for q in found[found != p]:
+            other = pieces == q
+            if (filled & other).sum() > ENCLOSED_FRACTION * other.sum():
+                return True
+    return False
 
 
 def _extent(contour_px, region_depth, intrinsics) -> tuple[float, float]:

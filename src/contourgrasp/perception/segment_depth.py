@@ -118,6 +118,8 @@ def seen_above_table(depth, intrinsics, *, min_height, plane, fill_holes, max_ho
     if plane is None:
         plane = fit_table_plane(d, intrinsics, depth_range=depth_range, seed=seed)
     above, dead_band = raised_pixels(d, intrinsics, plane, min_height=min_height, depth_range=depth_range)
+    if target is not None and np.shape(target) == above.shape:  # (a wrong shape: pick_object's error)
+        above &= np.asarray(target, dtype=bool)  # a candidate is split from what it touches (find_candidates)
     mask, notes = pick_object(above, dead_band, min_area_px,
                                f"more than {min_height * 1000:.0f} mm above the table", target=target)
     return make_segmentation("depth", mask, notes, plane=plane, filled_px=filled), d
