@@ -392,3 +392,10 @@ MODEL_FIT_TOLERANCE = 3e-3
 
 #: A neighbour whose centre of mass rose more than this (m) during a grasp was lifted with the target.
 NEIGHBOUR_LIFT = 0.02
+
+#: The bench (sim.bench.Bench): trials per object and planner, trials in all (objects x trials x planners; at about a
+#: second a trial per core, a day's work on a small cluster), and the largest first seed (numpy's seeds are unbounded;
+#: a bench's are kept to 31 bits so that seed + trial stays a plain integer everywhere).
+MAX_TRIALS = 1000
+MAX_BENCH_TRIALS = 100_000
+MAX_SEED = 2**31 - 1 - MAX_TRIALS

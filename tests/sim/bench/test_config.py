@@ -1,5 +1,7 @@
 """contourgrasp.sim.bench.config: what a bench runs, refused before any trial when it cannot run."""
 
+from dataclasses import replace
+
 import pytest
 
 from contourgrasp.cli import main
@@ -29,10 +31,15 @@ def test_bad_names_exit_2_and_write_nothing(argv, message, tmp_path, capsys):
     ({"trials": 0}, "trials must be an integer >= 1"),
     ({"trials": 1.5}, "trials must be an integer"),
     ({"seed": -1}, "seed must be an integer >= 0"),
+    ({"trials": 1001}, "trials must be at most 1000"),
+    ({"seed": 2**40}, "seed must be at most"),
+    ({"planners": ("paper", "default", "random"), "trials": 1000, "objects": "many"}, "at most 100000 in one bench"),
     ({"planners": ("paper", "paper")}, "planners must be distinct"),
 ])
 def test_a_bench_that_cannot_run_is_a_simulation_error(options, message):
     setup = {"objects": thesis_objects(["can"]), "trials": 1} | options
+    if setup["objects"] == "many":  # 40 differently named copies of the can
+        setup["objects"] = tuple(replace(thesis_objects(["can"])[0], name=f"can{i}") for i in range(40))
     with pytest.raises(SimulationError, match=message):
         Bench(**setup)
 

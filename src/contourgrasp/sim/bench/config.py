@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ...errors import SimulationError
+from ...tolerances import MAX_BENCH_TRIALS, MAX_SEED, MAX_TRIALS
 from ...hand import Hand
 from ...io.hand_file import load_hand
 from ...validation import choice, integer
@@ -91,8 +92,11 @@ class Bench:
             raise SimulationError(f"planners must be distinct names, got {', '.join(self.planners) or 'none'}")
         for planner in self.planners:
             synthesis_planner(planner)  # refuses an unknown name before any trial runs
-        object.__setattr__(self, "trials", integer("trials", self.trials, 1, error=SimulationError))
-        object.__setattr__(self, "seed", integer("seed", self.seed, 0, error=SimulationError))
+        object.__setattr__(self, "trials", integer("trials", self.trials, 1, maximum=MAX_TRIALS, error=SimulationError))
+        object.__setattr__(self, "seed", integer("seed", self.seed, 0, maximum=MAX_SEED, error=SimulationError))
+        if self.size > MAX_BENCH_TRIALS:
+            raise SimulationError(f"the bench asks for {self.size} trials ({len(names)} objects x {self.trials} trials x "
+                                  f"{len(self.planners)} planners): at most {MAX_BENCH_TRIALS} in one bench")
         for split, members in self.splits:
             missing = [m for m in members if m not in names]
             if missing or not members:
