@@ -192,27 +192,28 @@ def split_at_depth_steps(above, depth, min_area_px: int):
     1
     """
     step = np.zeros_like(above)
-    for axis in (0, 1):
-        jump = np.abs(np.diff(depth, axis=axis)) > CANDIDATE_DEPTH_STEP
-        both = np.logical_and(np.delete(above, -1, axis), np.delete(above, 0, axis)) & jump
-        lo, hi = [slice(None)] * 2, [slice(None)] * 2
-        lo[axis], hi[axis] = slice(0, -1), slice(1, None)
-        step[tuple(lo)] |= both
-        step[tuple(hi)] |= both
+    down = above[:-1] & above[1:] & (np.abs(depth[1:] - depth[:-1]) > CANDIDATE_DEPTH_STEP)
+    right = above[:, :-1] & above[:, 1:] & (np.abs(depth[:, 1:] - depth[:, :-1]) > CANDIDATE_DEPTH_STEP)
+    step[:-1] |= down
+    step[1:] |= down
+    step[:, :-1] |= right
+    step[:, 1:] |= right
+    count, regions, boxes, centroids = cv2.connectedComponentsWithStats(above.astype(np.uint8), connectivity=8)
     if not step.any():
-        count, labels, stats, centroids = cv2.connectedComponentsWithStats(above.astype(np.uint8), connectivity=8)
-        return count - 1, labels, stats, centroids
-    _, regions, boxes = cv2.connectedComponentsWithStats(above.astype(np.uint8), connectivity=8)[:3]
+        return count - 1, regions, boxes, centroids
     _, pieces, stats = cv2.connectedComponentsWithStats((above & ~step).astype(np.uint8), connectivity=8)[:3]
     keep = (stats[:, cv2.CC_STAT_AREA] >= min_area_px)[pieces] & (pieces > 0)
-    labels = np.where(above, pieces.max() + regions, 0)  # regions without a step stay whole
+    labels = None
     for region in np.unique(regions[step]):
         x, y, w, h = boxes[region, :4]
         box = np.s_[y:y + h, x:x + w]
         inside, seeds = regions[box] == region, keep[box] & (regions[box] == region)
-        if _encloses(pieces[box], seeds):
+        if _encloses(pieces[box], seeds, stats, (x, y)):
+            labels = np.where(above, pieces.max() + regions, 0) if labels is None else labels  # the rest stay whole
             rows, cols = ndimage.distance_transform_edt(~seeds, return_distances=False, return_indices=True)
             labels[box][inside] = pieces[box][rows[inside], cols[inside]]
+    if labels is None:
+        return count - 1, regions, boxes, centroids
     values = np.unique(labels[above])
     compact = np.zeros(labels.shape, dtype=np.int32)
     compact[above] = np.searchsorted(values, labels[above]) + 1
@@ -228,15 +229,24 @@ def split_at_depth_steps(above, depth, min_area_px: int):
     return count, compact, stats, centroids
 
 
-def _encloses(pieces, seeds) -> bool:
-    """Whether one labelled piece of ``seeds`` (the region's large pieces) has another mostly inside its filled outline."""
+def _encloses(pieces, seeds, stats, origin) -> bool:
+    """Whether one labelled piece of ``seeds`` (the region's large pieces) has another mostly inside its filled outline.
+
+    ``pieces`` and ``seeds`` are the region's box at ``origin`` (x, y) of the image, ``stats`` the pieces'
+    :func:`cv2.connectedComponentsWithStats` rows in the image: only a piece within another's bounding box can
+    be inside its outline, so only such pairs are filled (on that box) and counted.
+    """
     found = np.unique(pieces[seeds])
-    if len(found) < 2:
-        return False
-    for p in found:
-        filled = ndimage.binary_fill_holes(np.pad(pieces == p, 1))[1:-1, 1:-1]
-        for q in found[found != p]:
-            other = pieces == q
+    x, y = stats[found, 0] - origin[0], stats[found, 1] - origin[1]
+    w, h = stats[found, 2], stats[found, 3]
+    for i, p in enumerate(found):
+        within = (x >= x[i]) & (y >= y[i]) & (x + w <= x[i] + w[i]) & (y + h <= y[i] + h[i]) & (found != p)
+        if not within.any():
+            continue
+        box = np.s_[y[i]:y[i] + h[i], x[i]:x[i] + w[i]]
+        filled = ndimage.binary_fill_holes(np.pad(pieces[box] == p, 1))[1:-1, 1:-1]
+        for q in found[within]:
+            other = pieces[box] == q
             if (filled & other).sum() > ENCLOSED_FRACTION * other.sum():
                 return True
     return False
