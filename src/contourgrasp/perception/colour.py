@@ -13,13 +13,13 @@ can opener lying flat: depth sees only its raised grip). The pixels unlike the
 table's colour connected to the depth mask are its candidates, of which only
 the parts more than ``HALO_PX`` beyond the depth outline and of at least
 ``min_area_px`` are added: nearer colour evidence is shadow and the object's
-side, which the depth outline bounds better; evidence on another object
-standing on the table is that object's, not a flat part. An image without hue
-(grey: its three channels equal) cannot tell a light part from a light table
-by colour; there the evidence is completed from depth, by the pixels that
-stand above the table by more than its noise, however little, and pieces a
-few pixels from the object (``FLAT_GAP_PX``) are joined to it: a part's hinge
-or neck can look like the table (:func:`add_flat_parts`).
+side, which the depth outline bounds better. An image without hue (grey: its
+three channels equal) cannot tell a light part from a light table by colour;
+there the evidence is completed from depth, by the pixels that stand above
+the table by more than its noise, however little, less the other objects
+standing on the table, and pieces a few pixels from the object
+(``FLAT_GAP_PX``) are joined to it: a part's hinge or neck can look like the
+table (:func:`add_flat_parts`).
 """
 
 from __future__ import annotations
@@ -81,10 +81,11 @@ def add_flat_parts(
        filter cuts the noise about fivefold and keeps a part's edge. Colour
        is not given this test, because a colour image bounds a part more
        sharply than a depth sensor's low steps do.
-    3. With ``depth``, evidence on another object is dropped: a region
-       standing more than ``min_height`` above the table, of at least
-       ``min_area_px``, that does not touch the depth mask is a neighbour
-       (segmented on its own), not a flat part.
+    3. Without hue and with ``depth``, evidence on another object is
+       dropped: a region standing more than ``min_height`` above the table,
+       of at least ``min_area_px``, that does not touch the depth mask is a
+       neighbour (segmented on its own), not a flat part; else the heights
+       of step 2 would reach every neighbour.
     4. The evidence connected to the depth mask; without hue also the pieces
        of at least ``min_area_px`` that come within ``gap_px`` of what is
        joined so far, each joined by the shortest segment across the gap (as
@@ -115,7 +116,7 @@ def add_flat_parts(
     seg : Segmentation
         From :func:`segment_depth` (it needs the table ``plane``), best without the footprint.
     depth : (H, W) or (H, W, 1) float, optional
-        Depth in meters (holes filled, as segmented), for steps 2 and 3.
+        Depth in meters (holes filled, as segmented), for steps 2 and 3 (a grey image only).
     intrinsics : Intrinsics, optional
         Of the depth image; needed with ``depth``.
     colour_distance : float
@@ -158,12 +159,13 @@ def add_flat_parts(
     min_area_px = validation.integer("min_area_px", min_area_px, 1, error=PerceptionError)
     if seg.plane is None or seg.plane.inliers.shape != seg.mask.shape:
         raise PerceptionError("add_flat_parts needs a depth segmentation with its table plane")
-    height = None if depth is None else _heights(depth, intrinsics, seg)
-    others = None if height is None else _other_objects(height > min_height, seg.mask, min_area_px)
+    d = None if depth is None else _checked_depth(depth, intrinsics, seg.mask.shape)
     grey = not _has_hue(image)
+    height = _heights(d, intrinsics, seg.plane) if grey and d is not None else None
     halo = dilate(seg.mask, halo_px)
-    unlike = _unlike_table(image, seg.mask, halo, seg.plane.inliers, height if grey else None, others, _Evidence(
-        colour_distance, lightness_weight, shadow_lightness, halo_px, gap_px if grey else 0, height_sigmas, min_area_px))
+    unlike = _unlike_table(image, seg.mask, halo, seg.plane.inliers, height, _Evidence(
+        colour_distance, lightness_weight, shadow_lightness, halo_px, gap_px if grey else 0, height_sigmas, min_height,
+        min_area_px))
     _, labels, stats, _ = cv2.connectedComponentsWithStats((unlike & ~halo).astype(np.uint8), connectivity=8)
     large = stats[:, cv2.CC_STAT_AREA] >= min_area_px
     large[0] = False
@@ -186,6 +188,7 @@ class _Evidence:
     halo_px: int
     gap_px: int
     height_sigmas: float
+    min_height: float
     min_area_px: int
 
 
@@ -194,42 +197,48 @@ def _has_hue(image) -> bool:
     return bool(np.any(image[..., 0] != image[..., 1]) or np.any(image[..., 1] != image[..., 2]))
 
 
-def _heights(depth, intrinsics, seg) -> np.ndarray:
-    """(H, W) float: height (m) above ``seg``'s table of every valid depth pixel, 0 elsewhere."""
+def _checked_depth(depth, intrinsics, shape) -> np.ndarray:
+    """(H, W) float: ``depth`` checked against its ``intrinsics`` and the mask's ``shape``."""
     if intrinsics is None:
         raise PerceptionError("add_flat_parts: a depth image needs intrinsics")
     d = as_depth(depth)
     check_intrinsics(intrinsics).check_shape(d.shape, "depth image")
-    validation.same_size(d.shape, seg.mask.shape, "depth image", "mask", error=PerceptionError)
-    valid = valid_depth(d)
-    return np.where(valid, heights(np.where(valid, d, 0.0), intrinsics, seg.plane), 0.0)
+    validation.same_size(d.shape, shape, "depth image", "mask", error=PerceptionError)
+    return d
 
 
-def _unlike_table(image, depth_mask, halo, table, height, others, options):
+def _heights(depth, intrinsics, plane) -> np.ndarray:
+    """(H, W) float: height (m) above ``plane`` of every valid depth pixel, 0 elsewhere."""
+    valid = valid_depth(depth)
+    return np.where(valid, heights(np.where(valid, depth, 0.0), intrinsics, plane), 0.0)
+
+
+def _unlike_table(image, depth_mask, halo, table, height, options):
     """(H, W) bool: the evidence of flat parts joined to ``depth_mask`` (without it): steps 1-4 of
     :func:`add_flat_parts`.
 
     ``halo`` is the depth mask dilated by ``halo_px``; ``height`` the heights
-    above the table for step 2 (a grey image), or None; ``others`` the other
-    objects of step 3, or None; ``options.gap_px`` is 0 for a colour image. The work is done in a window
+    above the table of steps 2 and 3 (a grey image), or None;
+    ``options.gap_px`` is 0 for a colour image. The work is done in a window
     ``FLAT_WINDOW_PX`` beyond the table ring around the depth mask (a
     fraction of the frame), and again on the whole image only when the
     evidence found comes within reach of the opening of the window's edges
     inside the image, where it could continue: the result is the whole
-    image's either way (the median filter and a gap joined at the window's
-    edge aside, which that reach also covers).
+    image's either way (a neighbour cut by the window's edge, which step 3
+    may then miss, reaches it too; the median filter's and a gap's reach at
+    the edge are covered by that reach).
     """
     window = grown_box(depth_mask, 4 * options.halo_px + FLAT_WINDOW_PX)
     found = _unlike_in(image[window], depth_mask[window], halo[window], table[window],
-                       *(None if a is None else a[window] for a in (height, others)), options)
+                       None if height is None else height[window], options)
     if _reaches_inner_edge(found, window, depth_mask.shape, 2 * EVIDENCE_OPEN_PX + 1 + options.gap_px):
-        return _unlike_in(image, depth_mask, halo, table, height, others, options)
+        return _unlike_in(image, depth_mask, halo, table, height, options)
     unlike = np.zeros(depth_mask.shape, dtype=bool)
     unlike[window] = found
     return unlike
 
 
-def _unlike_in(image, depth_mask, halo, table, height, others, options):
+def _unlike_in(image, depth_mask, halo, table, height, options):
     """:func:`_unlike_table` on the given arrays (the whole image or a window holding the table ring)."""
     lab = cv2.cvtColor(np.ascontiguousarray(image), cv2.COLOR_RGB2LAB)
     ring = dilate(depth_mask, 4 * options.halo_px) & ~halo & table
@@ -245,8 +254,7 @@ def _unlike_in(image, depth_mask, halo, table, height, others, options):
     unlike |= lab[..., 0] < options.shadow_lightness * table_lab[0]
     if height is not None:
         unlike |= _above_table_noise(height, ring, options.height_sigmas)
-    if others is not None:
-        unlike &= ~others
+        unlike &= ~_other_objects(height > options.min_height, depth_mask, options.min_area_px)
     evidence = opening(unlike, EVIDENCE_OPEN_PX) & ~depth_mask
     return _joined(evidence, depth_mask, options.gap_px, options.min_area_px) & ~depth_mask
 
@@ -274,9 +282,11 @@ def _joined(evidence, mask, gap_px, min_area_px) -> np.ndarray:
     """(H, W) bool: ``mask`` with the ``evidence`` connected to it, and the pieces of at least ``min_area_px``
     within ``gap_px`` of what is joined so far, each with the shortest segment across its gap."""
     joined = connected_to(evidence | mask, mask)
+    if gap_px == 0:
+        return joined
     count, labels, stats, _ = cv2.connectedComponentsWithStats((evidence & ~joined).astype(np.uint8), connectivity=8)
     pending = [i for i in range(1, count) if stats[i, cv2.CC_STAT_AREA] >= min_area_px]
-    while gap_px > 0 and pending:
+    while pending:
         rows, cols = np.nonzero(np.isin(labels, pending))
         box = pixel_box(rows, cols, gap_px, mask.shape)
         if not joined[box].any():
