@@ -8,8 +8,9 @@ Methods, each returning a :class:`~contourgrasp.perception.region.Segmentation`:
     The region standing above the table; with a tilted camera its footprint.
 ``"auto"`` (:func:`segment`)
     Depth, plus the flat parts found by colour in the colour image registered
-    to the depth image (:mod:`contourgrasp.perception.colour`); the RGB steps
-    when depth cannot be used.
+    to the depth image (:mod:`contourgrasp.perception.colour`; in a grey image
+    also by their few millimetres of height); the RGB steps when depth cannot
+    be used.
 ``"mask"`` (:func:`segment_from_mask`)
     A binary mask given by the user.
 
