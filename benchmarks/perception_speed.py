@@ -17,12 +17,15 @@ Times are CPU time of the process by default (``--clock cpu``): on a machine sha
 wall time also counts the waits for a core; ``--clock wall`` measures wall time. OpenCV, BLAS and
 numba run on one thread, so CPU time is the time on one core.
 
+``--grey`` times every frame turned grey first (``segmentation.grey``: luma in three equal channels, as a
+grayscale camera stores it), where flat parts are also looked for in depth.
+
 ``--save FILE`` writes the medians as JSON; ``--baseline FILE`` adds them as the "before" columns
 of the table, so a run before and one after a change print both.
 
 Usage::
 
-    python benchmarks/perception_speed.py [--data PATH] [--runs 7] [--seeds 2] [--clock cpu|wall]
+    python benchmarks/perception_speed.py [--data PATH] [--runs 7] [--seeds 2] [--clock cpu|wall] [--grey]
         [--save F] [--baseline F]
 """
 
@@ -52,6 +55,7 @@ from contourgrasp.sim import build_scene, render  # noqa: E402
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from segmentation import default_data  # noqa: E402
 from segmentation import frames as real_frames  # noqa: E402
+from segmentation import grey  # noqa: E402
 
 SIM_OBJECTS = ("can", "case", "bottle", "stone1", "stone2")
 STAGES = ("fill", "segment", "metric", "perceive")
@@ -125,6 +129,7 @@ def main(argv=None) -> int:
     parser.add_argument("--runs", type=int, default=7, help="timed runs per frame; the median is kept")
     parser.add_argument("--seeds", type=int, default=2, help="simulated scenes per object")
     parser.add_argument("--clock", choices=sorted(CLOCKS), default="cpu", help="process CPU time or wall time")
+    parser.add_argument("--grey", action="store_true", help="time the frames turned grey (three equal channels)")
     parser.add_argument("--save", type=Path, help="write the medians (ms) to this JSON file")
     parser.add_argument("--baseline", type=Path, help="JSON of an earlier --save, printed as 'before'")
     args = parser.parse_args(argv)
@@ -135,7 +140,7 @@ def main(argv=None) -> int:
         print(f"no real frames under {args.data}/rgbd: simulated frames only", file=sys.stderr)
     results = {}
     for name, rgb, depth, intrinsics in frames + real:
-        results[name] = median_ms(rgb, depth, intrinsics, args.runs, CLOCKS[args.clock])
+        results[name] = median_ms(grey(rgb) if args.grey else rgb, depth, intrinsics, args.runs, CLOCKS[args.clock])
         print(f"{name}: {results[name]['perceive']:.1f} ms", file=sys.stderr, flush=True)
     baseline = json.loads(args.baseline.read_text()) if args.baseline else {}
     print("\n".join(table(results, baseline)))

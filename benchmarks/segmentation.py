@@ -12,11 +12,13 @@ it shifted the colour image onto the depth image (``Segmentation.colour_offset_p
 A second table (:func:`print_real_grey`) scores ``auto`` on the same frames with
 the colour image turned grey and stored as three equal channels (ITU-R 601
 luma), as a grayscale camera's driver stores it, against ``auto`` on colour.
+The rendered frames below are scored in grey too (:func:`print_simulated_grey`).
 
 A third table scores ``auto`` against exact truth, on frames the simulation
 renders (:func:`contourgrasp.sim.render`, with its depth noise) of the five
 thesis objects and a dark grey tool with a flat plate
-(:func:`contourgrasp.sim.objects.flat_tool`), ``--sim-seeds`` placements each,
+(:func:`contourgrasp.sim.objects.flat_tool`), and the same tool in a yellow as
+light as the table in grey (``YELLOW``), ``--sim-seeds`` placements each,
 from a camera 0.7 m from the table with the PrimeSense intrinsics, looking
 straight down and tilted 12.7 deg as the real frames are
 (:func:`contourgrasp.sim.tilted_view`); the colour image is misregistered by
@@ -26,7 +28,7 @@ footprint (the pixels that see the table where the object stands). ``auto``
 aims at the first from a top-down camera and at the second from a tilted one
 (its mean is in bold). This table needs no shared data.
 
-A third table scores the scenes of several objects of the bench
+A last table scores the scenes of several objects of the bench
 (:mod:`contourgrasp.sim.clutter`: ``clutter``, 2-4 YCB objects on the table,
 and ``bin``, 1-3 in a bin; the bench's SR300 camera, tilted 0-25 deg by the
 seed, its depth noise), ``--scene-seeds`` scenes per kind and YCB split, the
@@ -40,7 +42,8 @@ as the bench gives it) against the exact footprint (camera tilted more than
 against the objects present (:func:`contourgrasp.sim.truth_labels`, those
 seen by at least ``MIN_AREA_PX`` pixels): how many were found, and how many
 objects one candidate matches to IoU >= 0.5 (the bin's walls are a candidate
-of their own, matching no object).
+of their own, matching no object); and the target's IoU with the frame in grey
+(:func:`grey`, a refused frame scoring 0).
 
 Usage::
 
@@ -58,6 +61,7 @@ import sys
 import time
 import warnings
 from collections import Counter
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -76,10 +80,13 @@ TARGET_MEAN, TARGET_WORST = 0.90, 0.75
 #: Table columns: (heading, method, depth options). "depth, seen" is depth without the footprint.
 COLUMNS = (("rgb", "rgb", None), ("depth, seen", "depth", {"footprint": False}), ("depth", "depth", None),
            ("auto", "auto", None))
+#: The yellow tool's colour: unlike the table's in colour, as light in grey (ITU-R 601 luma 0.82 against the table's
+#: 0.84: 5 grey levels apart); in grey only depth tells its flat plate from the table.
+YELLOW = (1.0, 0.85, 0.2, 1.0)
 #: The simulated frames: objects, camera tilts (deg), a camera like the real frames' PrimeSense, and a
 #: colour-depth misregistration like theirs: depth pixel (u + dx, v + dy) sees colour pixel (u, v).
 SIM_OBJECTS = {"can": "can", "case": "case", "bottle": "bottle", "stone1": "stone1", "stone2": "stone2",
-               "tool": flat_tool()}
+               "tool": flat_tool(), "yellow tool": replace(flat_tool(), name="yellow tool", rgba=YELLOW)}
 SIM_TILTS_DEG = (0.0, 12.7)
 SIM_COLOUR_SHIFT = (1, -3)
 SIM_CAMERA = Camera(height=0.7, intrinsics=Intrinsics(fx=525.0, fy=525.0, cx=319.5, cy=239.5, width=640, height=480))
@@ -131,7 +138,8 @@ def iou(a, b) -> float:
 
 def simulated(seeds):
     """Per (object, tilt), one row per seed: IoU of ``auto`` against the exact seen region and footprint,
-    IoU of those two against each other, and the colour shift ``auto`` found."""
+    IoU of those two against each other, the colour shift ``auto`` found, and IoU of ``auto`` on the frame in
+    grey (:func:`grey`) against its aim (the footprint when tilted, else the region seen)."""
     rows = {}
     for name, spec in SIM_OBJECTS.items():
         for seed in range(seeds):
@@ -144,8 +152,11 @@ def simulated(seeds):
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore")
                     result = segment(misregistered, depth, SIM_CAMERA.intrinsics)
+                    in_grey = segment(grey(misregistered), depth, SIM_CAMERA.intrinsics)
+                aim = footprint if tilt > 2 else seen  # tolerances.TILT_PLANE_THRESHOLD: the footprint above 2 deg
                 rows.setdefault((name, tilt), []).append(
-                    (iou(result.mask, seen), iou(result.mask, footprint), iou(seen, footprint), result.colour_offset_px))
+                    (iou(result.mask, seen), iou(result.mask, footprint), iou(seen, footprint), result.colour_offset_px,
+                     iou(in_grey.mask, aim)))
     return rows
 
 
@@ -171,6 +182,25 @@ def print_simulated(seeds) -> None:
                      f"colour shift found {shifts} of {len(every)} frames")
     print("| **mean** | " + " | ".join(means) + " |\n")
     print("\n".join(notes))
+    print_simulated_grey(rows)
+
+
+def print_simulated_grey(rows) -> None:
+    """IoU of ``auto`` against its aim on the rendered frames in colour and in grey, per object and tilt."""
+    print("\nThe same rendered frames in grey (three equal channels): IoU of auto against its aim, mean (worst)\n")
+    heads = [f"{tilt:g} deg, {mode}" for tilt in SIM_TILTS_DEG for mode in ("colour", "grey")]
+    print("| object | " + " | ".join(heads) + " |")
+    print("|---|" + "---:|" * len(heads))
+    columns = {}
+    for name in SIM_OBJECTS:
+        cells = []
+        for tilt in SIM_TILTS_DEG:
+            for mode, k in (("colour", 1 if tilt > 2 else 0), ("grey", 4)):
+                c = np.array([r[k] for r in rows[name, tilt]])
+                columns.setdefault((tilt, mode), []).append(c)
+                cells.append(f"{c.mean():.3f} ({c.min():.3f})")
+        print(f"| {name} | " + " | ".join(cells) + " |")
+    print("| **mean** | " + " | ".join(f"**{np.concatenate(c).mean():.3f}**" for c in columns.values()) + " |")
 
 
 #: The scenes of several objects scored: kinds and the YCB splits their objects come from.
@@ -208,6 +238,11 @@ def _score_scene(scene, seed):
             target_iou, refused = iou(segmentation.mask, footprint if tilted else seen), 0
         except InputError:
             target_iou, refused = 0.0, 1
+        try:
+            in_grey = pipeline.perceive(grey(rgb), depth, intr, target_px=target_pixel(scene))[0]
+            grey_iou = iou(in_grey.mask, footprint if tilted else seen)
+        except InputError:
+            grey_iou = 0.0
         filled, _ = perception.fill_depth_holes(perception.as_depth(depth))
         try:
             candidates = perception.find_candidates(filled, intr, perception.fit_table_plane(filled, intr))
@@ -215,7 +250,7 @@ def _score_scene(scene, seed):
             candidates = ()
     present = [labels == k for k in range(1, len(scene.neighbours) + 2) if (labels == k).sum() >= MIN_AREA_PX]
     matched = sum(any(iou(c.mask, obj) >= MATCH_IOU for c in candidates) for obj in present)
-    return target_iou, refused, len(present), len(candidates), matched
+    return target_iou, refused, len(present), len(candidates), matched, grey_iou
 
 
 def print_rendered_scenes(seeds) -> None:
@@ -223,12 +258,12 @@ def print_rendered_scenes(seeds) -> None:
     print(f"\nScenes of several objects ({seeds} per kind and split, the bench's camera tilted 0-25 deg, its depth "
           f"noise): the target given by its pixel, candidates against the objects present\n")
     print("| scene | split | target IoU, mean (worst) | refused | objects present | candidates found | "
-          f"objects found (IoU >= {MATCH_IOU}) |")
-    print("|---|---|---:|---:|---:|---:|---:|")
+          f"objects found (IoU >= {MATCH_IOU}) | target IoU in grey, mean (worst) |")
+    print("|---|---|---:|---:|---:|---:|---:|---:|")
     for (kind, split), scores in rows.items():
         a = np.array(scores)
         print(f"| {kind} | {split} | {a[:, 0].mean():.3f} ({a[:, 0].min():.3f}) | {int(a[:, 1].sum())} | "
-              f"{int(a[:, 2].sum())} | {int(a[:, 3].sum())} | {int(a[:, 4].sum())} |")
+              f"{int(a[:, 2].sum())} | {int(a[:, 3].sum())} | {int(a[:, 4].sum())} | {a[:, 5].mean():.3f} ({a[:, 5].min():.3f}) |")
 
 
 def main(argv=None) -> int:

@@ -157,6 +157,18 @@ HALO_PX = 8
 #: Colour evidence is opened with a disc of this radius (px) to drop thin straps and specks.
 EVIDENCE_OPEN_PX = 2
 
+#: A piece of flat-part evidence of at least ``MIN_AREA_PX`` not touching the object but this close (px) to it
+#: is joined to it, by the shortest segment across the gap: a thin part's hinge or neck can look like the table.
+FLAT_GAP_PX = 8
+
+#: An image without hue (grey) also takes as evidence the pixels whose height above the table, median-filtered
+#: over 5 x 5 pixels, exceeds this many times that filtered height's spread on the table ring around the object
+#: (its median absolute deviation scaled to a Gaussian's sigma) ...
+FLAT_HEIGHT_SIGMAS = 5.0
+
+#: ... and at least this height (m): a floor for depth without noise.
+MIN_FLAT_HEIGHT = 0.0005
+
 #: Colour evidence is first looked for within this distance (px) beyond the table ring around the depth
 #: mask; the whole image is searched only when the evidence reaches that window's edge.
 FLAT_WINDOW_PX = 96

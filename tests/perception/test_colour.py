@@ -9,7 +9,7 @@ from scipy import ndimage
 
 from contourgrasp.perception import PerceptionWarning, SegmentationError, colour_offset, register_colour, segment, segment_depth
 from contourgrasp.perception import colour as colour_module
-from contourgrasp.tolerances import FLAT_WINDOW_PX, HALO_PX
+from contourgrasp.tolerances import FLAT_GAP_PX, FLAT_WINDOW_PX, HALO_PX
 from perception_scenes import H, W, CAMERA, TABLE_RGB, OBJECT_RGB, render, render_footprint, iou, with_flat_part, with_plate, shifted
 
 
@@ -136,3 +136,82 @@ def test_flat_part_reaching_the_border_is_refused():
     with pytest.raises(SegmentationError, match="not completely visible") as err:
         segment(rgb, depth, CAMERA)
     assert err.value.kind == "not-visible"
+
+
+def _grey_scene(*, centre=(0.0, 0.0), noise_m=0.0, seed=0):
+    """Top-down: a dark cylinder 2 cm high on a light grey table, in grey; depth with Gaussian noise."""
+    depth, rgb, truth, _ = render(height=0.02, centre=centre)
+    rgb[:] = 200
+    rgb[truth] = 60
+    depth = depth + np.random.default_rng(seed).normal(0.0, noise_m, depth.shape)
+    return depth, rgb, truth
+
+
+def _beside(truth, first_col, last_col):
+    """(H, W) bool: a strip 30 px tall from column ``first_col`` to ``last_col`` past the object's right edge."""
+    rows, cols = np.nonzero(truth)
+    strip = np.zeros_like(truth)
+    middle = (rows.min() + rows.max()) // 2
+    strip[middle - 15: middle + 15, cols.max() + first_col: cols.max() + last_col] = True
+    return strip & ~truth
+
+
+def test_a_grey_image_finds_a_part_as_light_as_the_table_by_its_height():
+    # A plate 4 mm high, grey as the table: no lightness test sees it, and depth's 10 mm threshold does not.
+    # Each depth pixel has 1 mm of noise (5 sigma: 5 mm, more than the plate); the 5 x 5 median cuts it to about
+    # a quarter, and the plate stands out.
+    depth, rgb, truth = _grey_scene(noise_m=0.001)
+    plate = _beside(truth, -2, 70)
+    depth[plate] -= 0.004
+    seg = segment(rgb, depth, CAMERA)
+    assert seg.method == "depth+rgb" and iou(seg.mask, truth | plate) > 0.9
+    assert segment(rgb, depth, CAMERA, colour_options={"height_sigmas": 100.0}).method == "depth"
+    tinted = rgb.copy()
+    tinted[..., 2] -= 10  # a hue: colour bounds parts better, and the height test is not used
+    assert segment(tinted, depth, CAMERA).method == "depth"
+
+
+def test_a_grey_flat_part_across_a_narrow_gap_is_joined():
+    # A dark plate 5 px from the object, beyond a gap as light as the table (a hinge): joined in grey, by the
+    # shortest segment across the gap; not 12 px away; and not in colour, where a gap would join neighbours.
+    depth, rgb, truth = _grey_scene()
+    near = _beside(truth, 6, 70)
+    rgb[near] = 70
+    seg = segment(rgb, depth, CAMERA)
+    assert seg.method == "depth+rgb" and iou(seg.mask, truth | near) > 0.9
+    assert (seg.mask & ~(truth | near)).sum() < 5 * FLAT_GAP_PX  # the bridge only
+    assert segment(rgb, depth, CAMERA, colour_options={"gap_px": 0}).method == "depth"
+    tinted = rgb.copy()
+    tinted[..., 2] -= 10
+    assert segment(tinted, depth, CAMERA).method == "depth"
+    depth, rgb, truth = _grey_scene()
+    rgb[_beside(truth, FLAT_GAP_PX + 5, 70)] = 70
+    assert segment(rgb, depth, CAMERA).method == "depth"
+
+
+def test_grey_evidence_stops_at_a_neighbour_standing_on_the_table():
+    # A plate 4 mm high (grey as the table) runs from the target to a smaller cylinder 75 px away. The height test
+    # sees the neighbour too, but a region standing above 10 mm that the target does not touch is another
+    # object: the plate is added, the neighbour is not.
+    depth, rgb, truth = _grey_scene()
+    other_depth, _, other, _ = render(height=0.02, radius=0.03, centre=(0.1, 0.0))
+    depth = np.minimum(depth, other_depth)
+    rgb[other] = 60
+    plate = _beside(truth, -2, 30) & ~other
+    depth[plate] -= 0.004
+    seg = segment(rgb, depth, CAMERA)
+    assert seg.method == "depth+rgb"
+    assert (seg.mask & other).sum() < 0.05 * other.sum()
+    assert iou(seg.mask, truth | plate) > 0.85
+
+
+def test_grey_height_evidence_is_measured_from_the_surface_around_the_object():
+    # The object stands on a floor 4 mm above the fitted table (a bin's floor, the table being the plane with most
+    # pixels): the floor is the surface there, not a flat part, though it stands above the table's noise.
+    depth, rgb, truth = _grey_scene(noise_m=0.001)
+    rows, cols = np.nonzero(truth)
+    floor = np.zeros_like(truth)
+    floor[rows.min() - 80: rows.max() + 80, cols.min() - 100: cols.max() + 100] = True
+    depth[floor & ~truth] -= 0.004
+    seg = segment(rgb, depth, CAMERA)
+    assert seg.method == "depth" and iou(seg.mask, truth) > 0.95

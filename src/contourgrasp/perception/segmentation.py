@@ -8,8 +8,9 @@ Methods, each returning a :class:`~contourgrasp.perception.region.Segmentation`:
     The region standing above the table; with a tilted camera its footprint.
 ``"auto"`` (:func:`segment`)
     Depth, plus the flat parts found by colour in the colour image registered
-    to the depth image (:mod:`contourgrasp.perception.colour`); the RGB steps
-    when depth cannot be used.
+    to the depth image (:mod:`contourgrasp.perception.colour`; in a grey image
+    also by their few millimetres of height); the RGB steps when depth cannot
+    be used.
 ``"mask"`` (:func:`segment_from_mask`)
     A binary mask given by the user.
 
@@ -78,8 +79,8 @@ def segment(
         ``"auto"``: :func:`segment_depth` when depth and intrinsics are given;
         with a colour image too, the region it sees above the table is grown by
         :func:`add_flat_parts` on the colour image registered to the depth
-        image (:func:`colour_offset`, :func:`register_colour`) before it is
-        moved onto the table; :func:`segment_rgb` when there is no depth, or
+        image (:func:`colour_offset`, :func:`register_colour`) and, for a grey
+        image, on the depth image, before it is moved onto the table; :func:`segment_rgb` when there is no depth, or
         when depth finds no table or nothing standing on it (the module
         docstring explains the rule). The result's ``method`` says what was
         used: ``"depth"``, ``"depth+rgb"`` or ``"rgb"``.
@@ -130,7 +131,8 @@ def segment(
     else:
         if offset is None:
             offset = colour_offset(rgb, d, seen.mask)
-        grown = add_flat_parts(register_colour(rgb, offset), seen, **colour_options)
+        grown = add_flat_parts(register_colour(rgb, offset), seen, d, intrinsics,
+                               **{"min_height": seen_options["min_height"], **colour_options})
         return with_footprint(replace(grown, colour_offset_px=offset), d, intrinsics, footprint,
                                seen_options["min_area_px"])
     result = segment_rgb(rgb, **rgb_options)
