@@ -219,8 +219,8 @@ def test_force_closure_agrees_with_the_lp(grasp):
 def test_epsilon_is_the_minimum_of_the_support_function(grasp):
     p, n, mu = grasp
     eps = q.epsilon(p, n, mu=mu)
-    if eps > 0:
-        assert support_radius(q.contact_wrenches(p, n, mu=mu)) == pytest.approx(eps, abs=1e-7)
+    if eps > 0:  # the reference's Nelder-Mead polish of a non-smooth max stalls within a few 1e-6 (one found: 2e-6)
+        assert support_radius(q.contact_wrenches(p, n, mu=mu)) == pytest.approx(eps, abs=1e-5)
 
 
 @given(grasps(), st.floats(0.0, 1.0))
