@@ -354,3 +354,11 @@ def test_planning_on_the_object_in_the_bin_takes_its_region_not_the_walls():
     result = plan_frame(None, bin_with_box(), CAMERA, cg.load_hand("five-finger-linear"), target_px=(250, 230),
                         segment="depth", **FAST)
     assert result.segmentation.mask.sum() == 60 * 60
+
+
+def test_in_grey_the_wall_an_object_was_split_from_is_no_flat_part_of_it():
+    """Grey images take flat-part evidence from the heights; the wall beside the box stands, but is another object."""
+    grey = np.full((H, W, 3), 128, dtype=np.uint8)
+    result = plan_frame(grey, bin_with_box(), CAMERA, cg.load_hand("five-finger-linear"), target_px=(250, 230),
+                        **FAST)
+    assert result.segmentation.mask.sum() == 60 * 60

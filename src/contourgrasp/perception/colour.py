@@ -82,10 +82,10 @@ def add_flat_parts(
        is not given this test, because a colour image bounds a part more
        sharply than a depth sensor's low steps do.
     3. Without hue and with ``depth``, evidence on another object is
-       dropped: a region standing more than ``min_height`` above the table,
-       of at least ``min_area_px``, that does not touch the depth mask is a
-       neighbour (segmented on its own), not a flat part; else the heights
-       of step 2 would reach every neighbour.
+       dropped: a region standing more than ``min_height`` above the table
+       outside the depth mask, of at least ``min_area_px``, is a neighbour
+       (segmented on its own, or a bin's wall the candidate was split from),
+       not a flat part; else the heights of step 2 would reach every neighbour.
     4. The evidence connected to the depth mask; without hue also the pieces
        of at least ``min_area_px`` that come within ``gap_px`` of what is
        joined so far, each joined by the shortest segment across the gap (as
@@ -260,11 +260,14 @@ def _unlike_in(image, depth_mask, halo, table, height, options):
 
 
 def _other_objects(standing, mask, min_area_px) -> np.ndarray:
-    """(H, W) bool: the 8-connected regions of ``standing`` of at least ``min_area_px`` that ``mask`` does not touch."""
-    count, labels, stats, _ = cv2.connectedComponentsWithStats(standing.astype(np.uint8), connectivity=8)
+    """(H, W) bool: the 8-connected regions of ``standing`` outside ``mask`` of at least ``min_area_px``.
+
+    Outside the mask, not merely not touching it: a candidate split from a bin's wall
+    (:func:`~contourgrasp.perception.candidates.split_at_depth_steps`) touches the wall.
+    """
+    count, labels, stats, _ = cv2.connectedComponentsWithStats((standing & ~mask).astype(np.uint8), connectivity=8)
     other = stats[:, cv2.CC_STAT_AREA] >= min_area_px
     other[0] = False
-    other[labels[dilate(mask, 1)]] = False
     return other[labels]
 
 
