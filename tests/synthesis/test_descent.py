@@ -62,6 +62,22 @@ def middle_pose(hand, edge_y, wall, tip_height, clearance):
     return np.array([x, y, 0.0])
 
 
+def circle(r, n=200):
+    """(n, 2) float: a circle of radius r about the origin."""
+    a = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    return np.c_[r * np.cos(a), r * np.sin(a)]
+
+
+def ringed_column(r, height, gap, ring_height):
+    """A column (the object) of radius r and a ring (an obstacle) from r + gap[0] to r + gap[1] around it."""
+    def h(x, y):
+        d = np.hypot(x, y)
+        return np.where(d <= r, height, np.where((d > r + gap[0]) & (d < r + gap[1]), ring_height, 0.0))
+
+    heights = scene(h)
+    return replace(heights, object=heights.heights == height, obstacles=heights.heights == ring_height)
+
+
 # A rim: a thin wall of height H under the middle finger only, its last row of cell centres at EDGE.
 H, TIP, EDGE = 0.04, 0.02, 0.1 + 0.5 * CELL
 
@@ -234,8 +250,7 @@ def test_the_search_keeps_the_open_hand_clear_of_a_tall_object(hand):
     from contourgrasp import synthesis
 
     r = 0.05
-    contour = np.c_[r * np.cos(np.linspace(0, 2 * np.pi, 200, endpoint=False)),
-                    r * np.sin(np.linspace(0, 2 * np.pi, 200, endpoint=False))]
+    contour = circle(r)
     heights = scene(lambda x, y: np.where(np.hypot(x, y) <= r, 0.12, 0.0))
     options = dict(xy_step=0.01, yaw_step=math.radians(8))
     flat = synthesis.search(contour, hand, **options)
@@ -267,11 +282,8 @@ def test_a_pose_blocked_only_by_a_neighbour_says_so(hand):
     from contourgrasp import synthesis
 
     r = 0.05
-    contour = np.c_[r * np.cos(np.linspace(0, 2 * np.pi, 200, endpoint=False)),
-                    r * np.sin(np.linspace(0, 2 * np.pi, 200, endpoint=False))]
-    ring = lambda x, y: (np.hypot(x, y) > r + 0.04) & (np.hypot(x, y) < r + 0.06)  # noqa: E731
-    heights = scene(lambda x, y: np.where(np.hypot(x, y) <= r, 0.05, np.where(ring(x, y), 0.15, 0.0)))
-    heights = replace(heights, object=heights.heights == 0.05, obstacles=heights.heights == 0.15)
+    contour = circle(r)
+    heights = ringed_column(r, 0.05, (0.04, 0.06), 0.15)
     with pytest.raises(NoFeasibleGrasp, match="blocked by a neighbouring object or the bin wall"):
         synthesis.search(contour, hand, descent=Descent(heights, 0.02, 0.02), xy_step=0.01, yaw_step=math.radians(8))
 
@@ -282,11 +294,8 @@ def test_a_low_ring_the_closing_fingers_would_cross_blocks_every_pose_and_says_s
     from contourgrasp import synthesis
 
     r = 0.05
-    contour = np.c_[r * np.cos(np.linspace(0, 2 * np.pi, 200, endpoint=False)),
-                    r * np.sin(np.linspace(0, 2 * np.pi, 200, endpoint=False))]
-    kerb = lambda x, y: (np.hypot(x, y) > r + 0.02) & (np.hypot(x, y) < r + 0.025)  # noqa: E731
-    heights = scene(lambda x, y: np.where(np.hypot(x, y) <= r, 0.05, np.where(kerb(x, y), 0.015, 0.0)))
-    heights = replace(heights, object=heights.heights == 0.05, obstacles=heights.heights == 0.015)
+    contour = circle(r)
+    heights = ringed_column(r, 0.05, (0.02, 0.025), 0.015)
     options = dict(xy_step=0.01, yaw_step=math.radians(8))
     plan = synthesis.search(contour, hand, descent=Descent(heights, 0.02, 0.02), **options)
     assert plan.descent.feasible[0]  # without the closing check the hand would close through the kerb
