@@ -1,0 +1,273 @@
+"""The hand's 3-D body: each finger a planar two-link chain below the palm, and the palm's plate.
+
+A hand may carry its bodies: per finger a :class:`FingerChain` and a
+:class:`Palm`. They live in the *3-D hand frame*: x and y those of the 2-D hand
+frame (:mod:`contourgrasp.hand.trajectory`), in the plane of the palm's underside, and z along the
+approach, positive *below* the palm toward the object (the camera's z for a top-down view). Every
+finger is a planar two-link chain (proximal, distal) in the vertical plane
+through its knuckle that holds its horizontal ``direction``; its closing is the
+one-DoF synergy of an underactuated hand,
+``q(s) = open_angles + s * (closed_angles - open_angles)`` for closing progress
+``s`` in [0, 1]. :func:`chain_tip` and :func:`chain_capsules` are its forward
+kinematics; :func:`check_chain` ties it to the 2-D trajectory the planner uses.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import tolerances as tol
+from .. import validation as check
+from ..contour.polygon import signed_area
+from ..errors import HandError
+from .trajectory import (
+    Finger,
+    Ray,
+    _pair,
+    _unit2,
+    polyline_distance,
+    trajectory_polyline,
+)
+
+
+@dataclass(frozen=True)
+class FingerChain:
+    """A finger's body: a planar two-link chain hanging below the palm (3-D hand frame, z down).
+
+    The chain lies in the vertical plane through the knuckle that holds the horizontal unit vector
+    ``direction``. Joint angles ``q = (q1, q2)``: ``q1`` is the proximal link's angle from the
+    approach axis (+z), positive toward ``direction``; ``q2`` the distal link's angle relative to
+    the proximal one, positive the same way (flexion). With absolute angles ``a1 = q1`` and
+    ``a2 = q1 + q2``::
+
+        joint = knuckle + l1 * (sin(a1) * direction, cos(a1))
+        tip   = joint   + l2 * (sin(a2) * direction, cos(a2))
+
+    Closing is one-DoF (the synergy of a one-motor hand): at closing progress ``s`` in [0, 1]
+    ``q(s) = open_angles + s * (closed_angles - open_angles)``. This is how the simulated hand's
+    tendon closes a free finger: each joint's preloaded spring balances the tendon torque, so both
+    joints move linearly in the tendon force between the finger's start and end force, their
+    ratio fixed (``contourgrasp.sim.hand_model``); ``s`` is that fraction of the way.
+
+    A finger that leans outward by ``tilt`` when open has ``open_angles = (-tilt, 0)``, and its
+    knuckle lies ``(l1 + l2) * sin(tilt)`` inward of its open tip along ``direction``.
+
+    Attributes
+    ----------
+    knuckle : (2,) float
+        The proximal joint's (x, y), m.
+    knuckle_depth : float
+        The proximal joint's depth below the palm's underside, m (>= 0; a post joins them).
+    direction : (2,) float
+        Unit horizontal direction of the chain's plane: positive flexion moves the tip along it.
+        Normalised on creation.
+    links : (2,) float
+        Proximal and distal link lengths, m (joint to joint, distal: joint to the tip, the centre
+        of the distal link's end cap).
+    radius : float
+        Radius of the links' capsules (and the post's), m.
+    open_angles, closed_angles : (2,) float
+        Joint angles (q1, q2) of the open (s = 0) and fully closed (s = 1) finger, rad.
+
+    Raises
+    ------
+    HandError
+        A value that is not a finite number in range (lengths up to ``tolerances.MAX_HAND_SIZE``,
+        angles up to ``tolerances.MAX_JOINT_ANGLE`` in magnitude), or a zero direction.
+    """
+
+    knuckle: tuple[float, float]
+    knuckle_depth: float
+    direction: tuple[float, float]
+    links: tuple[float, float]
+    radius: float
+    open_angles: tuple[float, float]
+    closed_angles: tuple[float, float]
+
+    def __post_init__(self):
+        size = tol.MAX_HAND_SIZE
+        object.__setattr__(self, "knuckle", _pair("chain knuckle", self.knuckle, size, " m", signed=True))
+        object.__setattr__(self, "knuckle_depth", check.bounded("chain knuckle_depth", self.knuckle_depth, size,
+                                                                " m", error=HandError))
+        object.__setattr__(self, "direction", _unit2("chain direction", self.direction))
+        object.__setattr__(self, "links", _pair("chain links", self.links, size, " m", positive=True))
+        object.__setattr__(self, "radius", check.bounded("chain radius", self.radius, size, " m", error=HandError))
+        for name in ("open_angles", "closed_angles"):
+            object.__setattr__(self, name, _pair(f"chain {name}", getattr(self, name), tol.MAX_JOINT_ANGLE,
+                                                 " rad", signed=True))
+
+    @property
+    def length(self) -> float:
+        """l1 + l2, m."""
+        return self.links[0] + self.links[1]
+
+
+@dataclass(frozen=True)
+class Palm:
+    """The palm: a plate whose underside is the polygon ``outline`` at z = 0, ``thickness`` above it.
+
+    Attributes
+    ----------
+    outline : (k, 2) float
+        The underside's outline in the hand frame, k >= 3 vertices in either order, m.
+    thickness : float
+        Extent above the underside (toward negative z), m.
+
+    Raises
+    ------
+    HandError
+        Fewer than 3 vertices, a value that is not finite or beyond ``tolerances.MAX_HAND_SIZE``,
+        an outline without area, or a thickness that is not positive.
+    """
+
+    outline: tuple[tuple[float, float], ...]
+    thickness: float
+
+    def __post_init__(self):
+        pts = check.float_array("palm outline", self.outline, error=HandError)
+        if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 3 or not np.isfinite(pts).all():
+            raise HandError(f"palm outline must be at least 3 finite (x, y) points, got {self.outline!r}")
+        check.at_most("palm |outline|", float(np.abs(pts).max()), tol.MAX_HAND_SIZE, " m", error=HandError)
+        if abs(signed_area(pts)) <= tol.MIN_AREA:
+            raise HandError("palm outline has no area")
+        check.bounded("palm thickness", self.thickness, tol.MAX_HAND_SIZE, " m", strict=True, error=HandError)
+        object.__setattr__(self, "outline", tuple((float(x), float(y)) for x, y in pts))
+        object.__setattr__(self, "thickness", float(self.thickness))
+
+    @property
+    def points(self) -> np.ndarray:
+        """(k, 2) float: the outline."""
+        return np.array(self.outline)
+
+
+def chain_angles(chain: FingerChain, s) -> np.ndarray:
+    """Joint angles along the closing synergy ``q(s) = open_angles + s * (closed_angles - open_angles)``.
+
+    Parameters
+    ----------
+    chain : FingerChain
+    s : float or (m,) float
+        Closing progress, 0 open, 1 fully closed.
+
+    Returns
+    -------
+    (m, 2) float
+        (q1, q2) per progress, rad.
+    """
+    s = np.atleast_1d(np.asarray(s, dtype=float))[:, None]
+    q_open, q_closed = np.asarray(chain.open_angles), np.asarray(chain.closed_angles)
+    return q_open + s * (q_closed - q_open)
+
+
+def chain_joints(chain: FingerChain, s) -> np.ndarray:
+    """Forward kinematics of :class:`FingerChain` in the 3-D hand frame (z down from the palm).
+
+    Parameters
+    ----------
+    chain : FingerChain
+    s : float or (m,) float
+        Closing progress in [0, 1].
+
+    Returns
+    -------
+    (m, 3, 3) float
+        Per progress, the knuckle, the middle joint and the tip, each (x, y, z), m.
+    """
+    q = chain_angles(chain, s)
+    a = np.cumsum(q, axis=1)  # absolute angles from +z: (m, 2)
+    (l1, l2), d = chain.links, np.asarray(chain.direction)
+    step = np.asarray([l1, l2]) * np.sin(a)  # along direction
+    down = np.asarray([l1, l2]) * np.cos(a)  # along z
+    knuckle = np.array([*chain.knuckle, chain.knuckle_depth])
+    links = np.concatenate([step[..., None] * d, down[..., None]], axis=-1)  # (m, 2, 3)
+    points = knuckle + np.concatenate([np.zeros((len(q), 1, 3)), np.cumsum(links, axis=1)], axis=1)
+    return points
+
+
+def chain_tip(chain: FingerChain, s) -> np.ndarray:
+    """The fingertip (the centre of the distal link's end cap) at closing progress ``s``.
+
+    Parameters
+    ----------
+    chain : FingerChain
+    s : float or (m,) float
+
+    Returns
+    -------
+    (m, 3) float
+        (x, y, z) in the 3-D hand frame, m.
+    """
+    return chain_joints(chain, s)[:, 2]
+
+
+def chain_capsules(chain: FingerChain, s) -> np.ndarray:
+    """The finger's capsules at closing progress ``s``, each of radius ``chain.radius``.
+
+    Capsules: the post from the palm's underside straight down to the knuckle (of zero length
+    when ``knuckle_depth`` is 0), the proximal link (knuckle to middle joint) and the distal link
+    (middle joint to tip), as the simulated hand builds them.
+
+    Parameters
+    ----------
+    chain : FingerChain
+    s : float or (m,) float
+
+    Returns
+    -------
+    (m, 3, 2, 3) float
+        Per progress, per capsule (post, proximal, distal), its two end points (x, y, z), m.
+    """
+    joints = chain_joints(chain, s)
+    top = joints[:, 0].copy()
+    top[:, 2] = 0.0
+    post = np.stack([top, joints[:, 0]], axis=1)
+    return np.stack([post, joints[:, :2], joints[:, 1:]], axis=1)
+
+
+def chain_deviation(finger: Finger, chain: FingerChain) -> tuple[float, float, float]:
+    """How far a chain's projected tip strays from the finger's 2-D trajectory, m.
+
+    Returns
+    -------
+    open, closed, path : float
+        Distance on the palm plane (x, y) of the open tip (s = 0) from ``finger.start``, of the
+        closed tip (s = 1) from ``finger.end``, and the largest distance of the tip at
+        ``tolerances.CHAIN_SAMPLES`` progresses evenly in [0, 1] from the trajectory over its
+        travel (:func:`trajectory_polyline`).
+    """
+    tips = chain_tip(chain, np.linspace(0.0, 1.0, tol.CHAIN_SAMPLES))[:, :2]
+    return (float(np.linalg.norm(tips[0] - finger.start)), float(np.linalg.norm(tips[-1] - finger.end)),
+            float(polyline_distance(tips, trajectory_polyline(finger)).max()))
+
+
+def check_chain(finger: Finger, chain: FingerChain) -> None:
+    """Refuse a chain that does not realise its finger's 2-D trajectory.
+
+    The chain's tip projected on the palm plane (its x, y) must be within
+    ``tolerances.CHAIN_TRAJECTORY`` (1 mm) of ``finger.start`` when open (s = 0), of
+    ``finger.end`` (the trajectory after ``travel``) when fully closed (s = 1), and of the 2-D
+    trajectory over ``[0, travel]`` -- the segment of a ray, the elliptic arc of an arc -- at
+    every one of ``tolerances.CHAIN_SAMPLES`` progresses evenly spaced in [0, 1]
+    (:func:`chain_deviation`). The chain's radius must be the finger's ``radius``.
+
+    Raises
+    ------
+    HandError
+        Naming the finger and what is off, by how much.
+    """
+    limit = tol.CHAIN_TRAJECTORY
+    what = f"finger {finger.name!r}: 3-D chain"
+    if not np.isclose(chain.radius, finger.radius, rtol=0.0, atol=1e-12):
+        raise HandError(f"{what} radius {chain.radius:g} m differs from the finger's radius {finger.radius:g} m")
+    open_, closed, path = chain_deviation(finger, chain)
+    for label, value in (("open tip is", open_), ("closed tip is", closed)):
+        if value > limit:
+            target = "the finger's start" if label.startswith("open") else "the end of the finger's travel"
+            raise HandError(f"{what} {label} {1000 * value:.2f} mm from {target} on the palm plane "
+                            f"(at most {1000 * limit:g} mm)")
+    if path > limit:
+        kind = "ray" if isinstance(finger.trajectory, Ray) else "arc"
+        raise HandError(f"{what}: tip path leaves the finger's {kind} by {1000 * path:.2f} mm on the palm plane "
+                        f"(at most {1000 * limit:g} mm)")
