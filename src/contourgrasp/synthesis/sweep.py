@@ -139,7 +139,30 @@ def closing_hits(hand: Hand, obstacles: HeightMap, pose, base: float, lam, touch
     """
     reaches = [float(travelled) - chain.radius if touches else float(_travel(chain)[1][-1])
                for chain, travelled, touches in zip(hand.chains, lam, touching)]
-    return _below_map(hand, obstacles, pose, base, reaches)
+    near = _near_obstacles(hand, obstacles, pose, reaches)
+    return _below_map(hand, obstacles, pose, base, np.where(near, reaches, np.nan))
+
+
+def _near_obstacles(hand: Hand, obstacles: HeightMap, pose, reaches) -> np.ndarray:
+    """(f,) bool: fingers whose swept capsules' box (grown by their radius and a cell) holds an obstacle cell's centre.
+
+    Most poses of a scene with a distant neighbour sweep nowhere near it; the exact check is for those that do.
+    """
+    rows, cols = np.nonzero(obstacles.heights > 0.0)
+    near = np.zeros(len(hand.chains), dtype=bool)
+    if not len(rows):
+        return near
+    centres = np.asarray(obstacles.origin, dtype=float) + (np.c_[cols, rows] + 0.5) * obstacles.cell
+    c, s = np.cos(pose[2]), np.sin(pose[2])
+    for f, (chain, reach) in enumerate(zip(hand.chains, reaches)):
+        if not reach > 0:
+            continue
+        ends = _swept_capsules(chain, float(reach))[..., :2].reshape(-1, 2)
+        placed = np.asarray(pose[:2], dtype=float) + ends @ np.array([[c, s], [-s, c]])
+        grow = chain.radius + obstacles.cell
+        low, high = placed.min(axis=0) - grow, placed.max(axis=0) + grow
+        near[f] = bool(np.any(np.all((centres >= low) & (centres <= high), axis=1)))
+    return near
     ends = np.concatenate(ends)
     radii = np.array([hand.chains[f].radius for f in owner], dtype=float)
     out = map_clearances(heights, hand, np.asarray(pose, dtype=float)[None], np.array([base], dtype=float), ends, radii)
