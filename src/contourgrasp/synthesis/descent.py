@@ -74,6 +74,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from functools import partial
 
 import numpy as np
 
@@ -83,7 +84,7 @@ from ..hand import Hand, chain_capsules, chain_tip
 from ..perception.height_map import HeightMap
 from ..tolerances import DESCENT_BATCH, DESCENT_MARGIN, MAX_DESCENT_POSES, MAX_HAND_SIZE
 from ._descent_kernels import map_clearances
-from .sweep import closing_hits, link_first, obstacle_map
+from .sweep import closing_hits, link_first, obstacle_centres, obstacle_map
 
 #: Parts of a finger's chain, in the order of :func:`~contourgrasp.hand.chain_capsules`.
 FINGER_PARTS = ("post", "proximal", "distal")
@@ -313,6 +314,7 @@ def check_candidates(hand: Hand, descent: Descent, poses, order, lam=None,
     last = cleared = None
     order = np.asarray(order, dtype=np.intp)[:MAX_DESCENT_POSES]
     obstacles = obstacle_map(descent.heights) if descent.closing and descent.heights.obstacles.any() else None
+    hits = None if obstacles is None else partial(closing_hits, centres=obstacle_centres(obstacles))
     for a in range(0, len(order), DESCENT_BATCH):
         rows = order[a:a + DESCENT_BATCH]
         last = descent_feasible(hand, descent.heights, poses[rows], descent.tip_height, margin=descent.margin)
@@ -323,7 +325,7 @@ def check_candidates(hand: Hand, descent: Descent, poses, order, lam=None,
         if descent.sweep and lam is not None:
             passed[rows] &= ~_swept(link_first, hand, descent.heights, poses[rows], raised, lam[rows], touching[rows])
         if obstacles is not None and lam is not None:
-            passed[rows] &= ~_swept(closing_hits, hand, obstacles, poses[rows], raised, lam[rows], touching[rows])
+            passed[rows] &= ~_swept(hits, hand, obstacles, poses[rows], raised, lam[rows], touching[rows])
         if passed[rows].any():
             break
     return passed, tip, cleared or last

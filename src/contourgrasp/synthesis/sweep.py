@@ -121,7 +121,14 @@ def obstacle_map(heights: HeightMap) -> HeightMap:
                    in_view=np.ones_like(heights.in_view))
 
 
-def closing_hits(hand: Hand, obstacles: HeightMap, pose, base: float, lam, touching) -> np.ndarray:
+def obstacle_centres(obstacles: HeightMap) -> np.ndarray:
+    """(k, 2) float: the planning-frame (x, y) of the centres of ``obstacles``'s raised cells (an :func:`obstacle_map`)."""
+    rows, cols = np.nonzero(obstacles.heights > 0.0)
+    return np.asarray(obstacles.origin, dtype=float) + (np.c_[cols, rows] + 0.5) * obstacles.cell
+
+
+def closing_hits(hand: Hand, obstacles: HeightMap, pose, base: float, lam, touching, *,
+                 centres=None) -> np.ndarray:
     """(f,) bool: per finger, whether its chain runs into an obstacle while it closes (module docstring).
 
     Parameters
@@ -136,30 +143,31 @@ def closing_hits(hand: Hand, obstacles: HeightMap, pose, base: float, lam, touch
         Each finger's planned travel to its grasp point, m (ignored where it misses).
     touching : (f,) bool
         A touching finger stops a radius before its grasp point; the others close to their end.
+    centres : (k, 2) float, optional
+        :func:`obstacle_centres` of ``obstacles``, when it is checked for many poses.
     """
     reaches = [float(travelled) - chain.radius if touches else float(_travel(chain)[1][-1])
                for chain, travelled, touches in zip(hand.chains, lam, touching)]
-    near = _near_obstacles(hand, obstacles, pose, reaches)
+    centres = obstacle_centres(obstacles) if centres is None else centres
+    near = _near_obstacles(hand, obstacles.cell, centres, pose, reaches)
     return _below_map(hand, obstacles, pose, base, np.where(near, reaches, np.nan))
 
 
-def _near_obstacles(hand: Hand, obstacles: HeightMap, pose, reaches) -> np.ndarray:
+def _near_obstacles(hand: Hand, cell: float, centres, pose, reaches) -> np.ndarray:
     """(f,) bool: fingers whose swept capsules' box (grown by their radius and a cell) holds an obstacle cell's centre.
 
     Most poses of a scene with a distant neighbour sweep nowhere near it; the exact check is for those that do.
     """
-    rows, cols = np.nonzero(obstacles.heights > 0.0)
     near = np.zeros(len(hand.chains), dtype=bool)
-    if not len(rows):
+    if not len(centres):
         return near
-    centres = np.asarray(obstacles.origin, dtype=float) + (np.c_[cols, rows] + 0.5) * obstacles.cell
     c, s = np.cos(pose[2]), np.sin(pose[2])
     for f, (chain, reach) in enumerate(zip(hand.chains, reaches)):
         if not reach > 0:
             continue
         ends = _swept_capsules(chain, float(reach))[..., :2].reshape(-1, 2)
         placed = np.asarray(pose[:2], dtype=float) + ends @ np.array([[c, s], [-s, c]])
-        grow = chain.radius + obstacles.cell
+        grow = chain.radius + cell
         low, high = placed.min(axis=0) - grow, placed.max(axis=0) + grow
         near[f] = bool(np.any(np.all((centres >= low) & (centres <= high), axis=1)))
     return near
