@@ -97,11 +97,10 @@ def find_candidates(
     speckle (:func:`~contourgrasp.perception.segment_depth.raised_pixels`,
     what :func:`~contourgrasp.perception.segment_depth.segment_depth`
     chooses from), split into 8-connected regions; those of at least
-    ``min_area_px`` pixels are the candidates. Objects that touch in the image
-    but not in space -- an object against a bin's wall, a box before a taller
-    neighbour -- are one such region, so regions are also split where the depth
+    ``min_area_px`` pixels are the candidates. An object against a bin's wall
+    is one such region with the wall, so a region is also split where the depth
     steps by more than ``tolerances.CANDIDATE_DEPTH_STEP`` between raised
-    4-neighbours (:func:`split_at_depth_steps`).
+    4-neighbours and one piece then encloses another (:func:`split_at_depth_steps`).
 
     Parameters
     ----------
