@@ -154,13 +154,31 @@ def closing_hits(hand: Hand, obstacles: HeightMap, pose, base: float, lam, touch
 
 
 def _near_obstacles(hand: Hand, cell: float, centres, pose, reaches) -> np.ndarray:
-    """(f,) bool: fingers whose swept capsules' box (grown by their radius and a cell) holds an obstacle cell's centre.
+    """(f,) bool: fingers whose whole closing sweep's box (grown by their radius and a cell) holds an obstacle cell.
 
     Most poses of a scene with a distant neighbour sweep nowhere near it; the exact check is for those that do.
+    The box is the whole sweep's (:func:`_sweep_points`), computed once per finger: a finger that stops
+    earlier sweeps inside it, so no finger that could hit is left out.
     """
     near = np.zeros(len(hand.chains), dtype=bool)
     if not len(centres):
         return near
+    c, s = np.cos(pose[2]), np.sin(pose[2])
+    turn = np.array([[c, s], [-s, c]])
+    for f, (chain, reach) in enumerate(zip(hand.chains, reaches)):
+        if not reach > 0:
+            continue
+        placed = np.asarray(pose[:2], dtype=float) + _sweep_points(chain) @ turn
+        grow = chain.radius + cell
+        low, high = placed.min(axis=0) - grow, placed.max(axis=0) + grow
+        near[f] = bool(np.any(np.all((centres >= low) & (centres <= high), axis=1)))
+    return near
+
+
+@lru_cache(maxsize=64)
+def _sweep_points(chain: FingerChain) -> np.ndarray:
+    """(k, 2) float: the (x, y) of the capsules' ends over the finger's whole closing, hand frame."""
+    return _swept_capsules(chain, float(_travel(chain)[1][-1]))[..., :2].reshape(-1, 2)
     c, s = np.cos(pose[2]), np.sin(pose[2])
     for f, (chain, reach) in enumerate(zip(hand.chains, reaches)):
         if not reach > 0:
