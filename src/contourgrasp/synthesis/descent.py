@@ -74,7 +74,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from functools import partial
+from functools import cached_property, partial
 
 import numpy as np
 
@@ -182,6 +182,16 @@ class Descent:
         validation.bounded("margin", self.margin, MAX_HAND_SIZE, " m", error=PlannerError)
         validation.flag("sweep", self.sweep, error=PlannerError)
         validation.flag("closing", self.closing, error=PlannerError)
+
+    @cached_property
+    def closing_map(self) -> tuple[HeightMap, np.ndarray] | None:
+        """With ``closing`` and a map that has obstacle cells: their map alone and their centres
+        (:func:`~contourgrasp.synthesis.sweep.obstacle_map`, :func:`~contourgrasp.synthesis.sweep.obstacle_centres`),
+        found once for every batch of candidates; else None."""
+        if not self.closing or not self.heights.obstacles.any():
+            return None
+        only = obstacle_map(self.heights)
+        return only, obstacle_centres(only)
 
 
 def body_names(hand: Hand) -> tuple[str, ...]:
@@ -313,19 +323,19 @@ def check_candidates(hand: Hand, descent: Descent, poses, order, lam=None,
     tip = np.full(len(poses), np.nan)
     last = cleared = None
     order = np.asarray(order, dtype=np.intp)[:MAX_DESCENT_POSES]
-    obstacles = obstacle_map(descent.heights) if descent.closing and descent.heights.obstacles.any() else None
-    hits = None if obstacles is None else partial(closing_hits, centres=obstacle_centres(obstacles))
     for a in range(0, len(order), DESCENT_BATCH):
         rows = order[a:a + DESCENT_BATCH]
         last = descent_feasible(hand, descent.heights, poses[rows], descent.tip_height, margin=descent.margin)
-        raised = descent.tip_height + np.maximum(descent.margin - last.clearance.min(axis=1), 0.0)
+        raised = _raised(last)
         tip[rows] = raised
         passed[rows] = raised <= descent.max_tip_height
         cleared = last if passed[rows].any() else cleared
         if descent.sweep and lam is not None:
             passed[rows] &= ~_swept(link_first, hand, descent.heights, poses[rows], raised, lam[rows], touching[rows])
-        if obstacles is not None and lam is not None:
-            passed[rows] &= ~_swept(hits, hand, obstacles, poses[rows], raised, lam[rows], touching[rows])
+        if descent.closing_map is not None and lam is not None:
+            obstacles, centres = descent.closing_map
+            passed[rows] &= ~_swept(partial(closing_hits, centres=centres), hand, obstacles, poses[rows], raised,
+                                    lam[rows], touching[rows])
         if passed[rows].any():
             break
     return passed, tip, cleared or last
@@ -333,10 +343,12 @@ def check_candidates(hand: Hand, descent: Descent, poses, order, lam=None,
 
 def descends_clear(descent: Descent, check: DescentCheck | None) -> bool:
     """Whether some pose of ``check`` descends clear within ``descent.max_tip_height`` (raised where it must be)."""
-    if check is None:
-        return False
-    raised = check.tip_height + np.maximum(check.margin - check.clearance.min(axis=1), 0.0)
-    return bool((raised <= descent.max_tip_height).any())
+    return check is not None and bool((_raised(check) <= descent.max_tip_height).any())
+
+
+def _raised(check: DescentCheck) -> np.ndarray:
+    """(p,) float: each checked pose's grasp height raised by what its least clearance lacks of the margin."""
+    return check.tip_height + np.maximum(check.margin - check.clearance.min(axis=1), 0.0)
 
 
 def blocked_by_obstacles(hand: Hand, descent: Descent, check: DescentCheck) -> bool:

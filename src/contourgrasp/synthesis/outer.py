@@ -264,7 +264,7 @@ def _diagnose_descent(hand: Hand, check: DescentCheck, n: int, descent: Descent)
 
 def _diagnose_closing(descent: Descent, n: int) -> str:
     """Why poses whose open hand descends clear were refused: a closing finger's chain (:mod:`.sweep`)."""
-    closing = descent.closing and bool(descent.heights.obstacles.any())
+    closing = descent.closing_map is not None
     hits = "run a finger into a neighbouring object or the bin wall" if closing else ""
     early = "meet the object with a finger's link before its tip" if descent.sweep else ""
     what = " or ".join(w for w in (hits, early) if w)
