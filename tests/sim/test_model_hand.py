@@ -5,10 +5,10 @@ import pytest
 
 from contourgrasp import tolerances as tol
 from contourgrasp.errors import HandError, HandFileError
-from contourgrasp.hand import Arc, Ray
+from contourgrasp.hand import Ray
 from contourgrasp.io.hand_file import hand_to_toml, load_hand, parse_hand
 from contourgrasp.sim.hand_model import build_hand
-from contourgrasp.sim.model_hand import MODELS, derive_hand, fit_finger
+from contourgrasp.sim.model_hand import MODELS, derive_hand
 
 #: Two fingers sliding straight in the palm plane: known rays (see the file).
 TWO_SLIDERS = Path(__file__).parent / "fixtures" / "two-sliders.xml"
@@ -73,18 +73,6 @@ def test_the_approach_axis_decides_the_palm_plane(sliders):
     np.testing.assert_allclose(flipped.start, [-0.05, -0.01], atol=1e-6)  # x kept, y = z x x turned over
     with pytest.raises(HandFileError, match="approach must be one of x, -x"):
         derive_hand(sliders, fingertips=["left_tip", "right_tip"], approach="up")
-
-
-def test_fit_finger_recovers_an_arc_and_refuses_a_zigzag():
-    truth = Arc(0.05, 0.03, 3.5)
-    lam = np.linspace(0.0, 0.06, 300)
-    path = np.array([0.1, 0.2]) + truth.offset(lam)
-    finger, fit = fit_finger("curl", path)
-    assert fit.kind == "arc" and fit.error < 1e-6 and fit.ray_error > tol.MODEL_FIT_TOLERANCE
-    assert finger.travel == pytest.approx(0.06, abs=1e-5)
-    zigzag = np.stack([np.linspace(0, 0.05, 50), 0.01 * np.sign(np.sin(np.linspace(0, 20, 50)))], axis=1)
-    with pytest.raises(HandError, match="finger 'zig': no ray or arc fits"):
-        fit_finger("zig", zigzag)
 
 
 @pytest.mark.parametrize("name, fingers", [("inspire", 5), ("jaco-three-finger", 3)])

@@ -112,6 +112,11 @@ class Arc:
         s, theta = self._length_table
         return np.interp(lam, s, theta)
 
+    def length(self, theta) -> np.ndarray:
+        """Arc length (m) after travelling the angle ``theta`` (rad) on the ellipse: the inverse of :meth:`angle`."""
+        s, table = self._length_table
+        return np.interp(theta, table, s)
+
     def offset(self, lam) -> np.ndarray:
         """(m, 2) float: displacement from the start point after arc length ``lam`` (eq 3.20)."""
         a = self.phi_off + self.angle(np.atleast_1d(lam))

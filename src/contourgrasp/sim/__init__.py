@@ -26,7 +26,8 @@ Example::
 
 from .hand_model import TIMINGS, ChainRule, FingerTiming, HandDesign, HandModel, build_hand, derive_body
 from .measure import fingertip_path_error, fingertip_paths
-from .model_hand import MODELS, Derivation, FingerFit, ModelSpec, derive_hand, fit_finger
+from .model_fit import FingerFit, fit_finger
+from .model_hand import MODELS, Derivation, ModelSpec, derive_hand
 from .model_mount import MountedHand, mount_model
 from .objects import THESIS_OBJECTS, ObjectSpec, Part, mesh_object, object_spec
 from .render import BIN_LABEL, DepthNoise, object_truth, render, render_view, tilted_view, truth_labels

@@ -1,0 +1,150 @@
+"""Fitting a model's measured closing with the thesis's trajectories (3.3) and a finger's planar chain.
+
+Pure numpy on the paths :mod:`contourgrasp.sim.model_hand` records (its docstring has the reading of
+the model): :func:`fit_finger` fits a projected fingertip path with a ray (eq 3.18) or, when the ray
+leaves it by more than ``tolerances.MODEL_FIT_TOLERANCE``, an axis-aligned elliptic arc (eq 3.20,
+a least-squares conic); :func:`travelled` reads a path as distances along the fitted trajectory;
+:func:`fit_chain` measures a two-hinge finger's :class:`~contourgrasp.hand.FingerChain`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import tolerances as tol
+from ..errors import HandError
+from ..hand import Arc, Finger, FingerChain, Ray, check_chain, polyline_distance
+
+#: Default gains of a derived hand's fingers (the five-finger-linear preset's).
+ALPHA, BETA = 25.0, 10000.0
+
+
+@dataclass(frozen=True)
+class FingerFit:
+    """How one fingertip's projected path was fitted.
+
+    Attributes
+    ----------
+    name : str
+    kind : str
+        ``"ray"`` or ``"arc"``.
+    error : float
+        Largest distance of the projected path from the fitted trajectory, m.
+    ray_error : float
+        That distance for the ray (the first fit tried), m.
+    """
+
+    name: str
+    kind: str
+    error: float
+    ray_error: float
+
+
+def fit_finger(name: str, path, *, radius: float = 0.0) -> tuple[Finger, FingerFit]:
+    """The finger whose trajectory fits a projected fingertip path: a ray, else an elliptic arc.
+
+    Parameters
+    ----------
+    name : str
+    path : (k, 2) float
+        The fingertip on the palm plane from open (first) to closed (last), hand frame, m.
+    radius : float
+        The finger's radius, m.
+
+    Returns
+    -------
+    Finger, FingerFit
+
+    Raises
+    ------
+    HandError
+        Neither fits within ``tolerances.MODEL_FIT_TOLERANCE`` (naming the finger and both errors).
+    """
+    path = np.asarray(path, dtype=float)
+    start, end = path[0], path[-1]
+    travel = float(np.linalg.norm(end - start))
+    if travel < tol.FINGER_MOVED:
+        raise HandError(f"finger {name!r}: its tip moves {1000 * travel:.2f} mm on the palm plane from open to closed "
+                        f"(at least {1000 * tol.FINGER_MOVED:g} mm)")
+    ray = Finger(name=name, start=tuple(start), trajectory=Ray(tuple((end - start) / travel)), travel=travel,
+                 alpha=ALPHA, beta=BETA, radius=radius)
+    ray_error = float(polyline_distance(path, [start, end]).max())
+    if ray_error <= tol.MODEL_FIT_TOLERANCE:
+        return ray, FingerFit(name, "ray", ray_error, ray_error)
+    arc, arc_error = _fit_arc(name, path, radius)
+    if arc is not None and arc_error <= tol.MODEL_FIT_TOLERANCE:
+        return arc, FingerFit(name, "arc", arc_error, ray_error)
+    arc_text = f"arc {1000 * arc_error:.2f} mm" if arc is not None else "no arc (the path turns clockwise or is no ellipse)"
+    raise HandError(f"finger {name!r}: no ray or arc fits its tip path on the palm plane within "
+                    f"{1000 * tol.MODEL_FIT_TOLERANCE:g} mm (ray {1000 * ray_error:.2f} mm, {arc_text})")
+
+
+def _fit_arc(name: str, path: np.ndarray, radius: float) -> tuple[Finger | None, float]:
+    """The arc (eq 3.20's axis-aligned ellipse) through a path: a least-squares conic, then the arc on it."""
+    mean = path.mean(axis=0)
+    scale = float(np.abs(path - mean).max())
+    x, y = ((path - mean) / scale).T
+    design = np.stack([x * x, y * y, x, y, np.ones_like(x)], axis=1)
+    a, b, c, e, f = np.linalg.svd(design)[2][-1]
+    if a * b <= 0:
+        return None, np.inf
+    cx, cy = -c / (2 * a), -e / (2 * b)
+    level = a * cx * cx + b * cy * cy - f
+    if level / a <= 0:
+        return None, np.inf
+    a_cos, a_sin = scale * np.sqrt(level / a), scale * np.sqrt(level / b)
+    centre = mean + scale * np.array([cx, cy])
+    angles = np.unwrap(np.arctan2((path[:, 1] - centre[1]) / a_sin, (path[:, 0] - centre[0]) / a_cos))
+    if angles[-1] <= angles[0] or max(a_cos, a_sin) > tol.MAX_HAND_SIZE:
+        return None, np.inf
+    try:
+        arc = Arc(float(a_cos), float(a_sin), float(angles[0]))
+        travel = float(arc.length(angles[-1] - angles[0]))
+        finger = Finger(name=name, start=tuple(path[0]), trajectory=arc, travel=travel, alpha=ALPHA, beta=BETA,
+                        radius=radius)
+    except HandError:
+        return None, np.inf
+    return finger, float(polyline_distance(path, finger.points(np.linspace(0.0, travel, tol.CHAIN_ARC_VERTICES))).max())
+
+
+def travelled(finger: Finger, path) -> np.ndarray:
+    """(k,) float: distance along the finger's trajectory of each path point's nearest trajectory point, m."""
+    lam = np.linspace(0.0, finger.travel, tol.CHAIN_ARC_VERTICES)
+    if isinstance(finger.trajectory, Ray):
+        return (np.asarray(path) - finger.start) @ np.asarray(finger.trajectory.closing_direction)
+    points = finger.points(lam)
+    nearest = np.linalg.norm(np.asarray(path)[:, None] - points[None], axis=2).argmin(axis=1)
+    return lam[nearest]
+
+
+def fit_chain(finger: Finger, tips: np.ndarray, joints: np.ndarray) -> tuple[FingerChain | None, str]:
+    """A two-link chain of a ray finger with two moving hinges, or None and why not.
+
+    ``tips`` (k, 3): the fingertip, ``joints`` (2, k, 3): the two hinges' positions, hand frame, m, from open
+    (first) to closed (last); the chain's open and closed angles are measured in its plane.
+    """
+    if not isinstance(finger.trajectory, Ray):
+        return None, f"finger {finger.name!r}: closes on an arc, which a planar chain cannot follow"
+    if len(joints) != 2:
+        return None, f"finger {finger.name!r}: {len(joints)} hinge joints between palm and tip; a chain has two"
+    knuckle, middle = joints
+    direction = np.asarray(finger.trajectory.closing_direction)
+    if knuckle[0, 2] < 0:
+        return None, f"finger {finger.name!r}: its first joint is {1000 * -knuckle[0, 2]:.1f} mm above the palm's underside"
+
+    def angle(a, b):  # absolute angles (open, closed) from +z, positive toward the closing direction
+        v = b[[0, -1]] - a[[0, -1]]
+        return np.arctan2(v[:, :2] @ direction, v[:, 2])
+
+    a1, a2 = angle(knuckle, middle), angle(middle, tips)
+    links = (float(np.linalg.norm(middle[0] - knuckle[0])), float(np.linalg.norm(tips[0] - middle[0])))
+    try:
+        chain = FingerChain(knuckle=tuple(knuckle[0, :2]), knuckle_depth=float(knuckle[0, 2]), direction=tuple(direction),
+                            links=links, radius=finger.radius, open_angles=(float(a1[0]), float(a2[0] - a1[0])),
+                            closed_angles=(float(a1[1]), float(a2[1] - a1[1])))
+        check_chain(finger, chain)
+    except HandError as err:
+        return None, str(err)
+    return chain, ""
