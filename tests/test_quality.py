@@ -127,7 +127,7 @@ def test_all_contacts_on_one_face_never_close(mu):
     """Thesis chapter 5, failure 2: every force pushes +y, nothing pulls back."""
     p = np.c_[np.linspace(-0.05, 0.05, 5), np.full(5, -0.02)]
     n = np.tile([0.0, 1.0], (5, 1))
-    assert q.grasp_quality(p, n, mu=mu) == q.GraspQuality(False, 0.0, "L1", mu)
+    assert q.grasp_quality(p, n, mu=mu) == q.GraspQuality(False, 0.0, "L1", mu, 1.0)
 
 
 def test_thumb_opposite_the_fingers_closes_the_glasses_case():
@@ -292,7 +292,7 @@ def test_grasp_quality_is_a_frozen_plain_record():
     p, n = antipodal()
     result = q.grasp_quality(p, n, mu=0.5, metric="Linf")
     assert result.force_closure is True and type(result.epsilon) is float
-    assert result.metric == "Linf" and result.mu == 0.5
+    assert result.metric == "Linf" and result.mu == 0.5 and result.imbalance == 0.0
     assert dataclasses.asdict(result)["epsilon"] == pytest.approx(1 / math.sqrt(3))
     with pytest.raises(dataclasses.FrozenInstanceError):
         result.epsilon = 1.0
@@ -433,3 +433,44 @@ def test_fuzz_quality_entry_points_return_or_raise_a_quality_error(n, data, mu, 
         except QualityError:
             continue
         assert np.all(np.isfinite(result)) and np.all(np.asarray(result) >= 0)
+
+
+# ------------------------------------------------------------ the squeeze's imbalance
+
+
+@pytest.mark.parametrize("count", [2, 3, 5])
+def test_evenly_spaced_pushes_cancel(count):
+    angles = np.linspace(0, 2 * np.pi, count, endpoint=False) + 0.3
+    normals = np.stack([np.cos(angles), np.sin(angles)], axis=1)[None]
+    assert q.imbalance(normals)[0] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_pushes_one_way_leave_all_their_force():
+    normals = np.array([[[0.0, 2.0], [0.0, 0.5], [0.0, 1.0]]])  # lengths do not matter, only directions
+    assert q.imbalance(normals)[0] == pytest.approx(1.0)
+
+
+def test_a_thumb_against_fingers_at_right_angles():
+    # thumb along +x, two fingers along -y: |(1, -2)| / 3
+    normals = np.array([[[1.0, 0.0], [0.0, -1.0], [0.0, -1.0]]])
+    assert q.imbalance(normals)[0] == pytest.approx(math.sqrt(5) / 3)
+
+
+def test_imbalance_ignores_missing_contacts_and_is_one_without_any():
+    normals = np.array([[[1.0, 0.0], [-1.0, 0.0], [np.nan, np.nan]], [[1.0, 0.0], [0.0, 1.0], [0.0, 1.0]]])
+    valid = np.array([[True, True, False], [False, False, False]])
+    assert q.imbalance(normals, valid).tolist() == [0.0, 1.0]
+
+
+@given(st.floats(0, 2 * np.pi), st.lists(st.floats(0, 2 * np.pi), min_size=1, max_size=6))
+def test_imbalance_is_a_share_invariant_under_rotation(turn, angles):
+    normals = np.stack([np.cos(angles), np.sin(angles)], axis=1)[None]
+    turned = normals @ np.array([[np.cos(turn), np.sin(turn)], [-np.sin(turn), np.cos(turn)]])
+    share = q.imbalance(normals)[0]
+    assert 0.0 <= share <= 1.0 + 1e-12
+    assert q.imbalance(turned)[0] == pytest.approx(share, abs=1e-9)
+
+
+def test_imbalance_refuses_a_zero_normal():
+    with pytest.raises(QualityError, match="normals"):
+        q.imbalance(np.array([[[1.0, 0.0], [0.0, 0.0]]]))

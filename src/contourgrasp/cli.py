@@ -219,6 +219,9 @@ def _add_synthesis_options(parser) -> None:
     parser.add_argument("--require-closure", action=argparse.BooleanOptionalAction,
                         help="only poses whose grasp points are in force closure")
     parser.add_argument("--quality-gain", type=_non_negative_float, help="cost term -gain * epsilon")
+    parser.add_argument("--max-imbalance", type=_non_negative_float,
+                        help="refuse poses whose equal finger pushes leave more net force, share of their sum "
+                             "(0..1; 1: off)")
     parser.add_argument("--top-k", type=_positive_int, default=10, help="ranked distinct poses to report")
     parser.add_argument("--refine", action=argparse.BooleanOptionalAction,
                         help="refine the best grid poses continuously (x, y, yaw) and report the gain")
@@ -300,6 +303,7 @@ def _plan_options(args) -> dict:
         "friction": args.friction,
         "require_closure": args.require_closure,
         "quality_gain": args.quality_gain,
+        "max_imbalance": args.max_imbalance,
         "depth_mode": getattr(args, "depth_mode", None),
         "footprint": getattr(args, "footprint", None),
         "top_k": args.top_k,

@@ -21,21 +21,20 @@ Hand frame (``T_camera_hand``)
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from . import perception, validation
-from .errors import HandError, NoFeasibleGrasp, PerceptionError, PlannerError, SegmentationError
+from .errors import HandError, PerceptionError, PlannerError, SegmentationError
 from .hand import Hand
 from .perception import HeightMap, Intrinsics, MetricContour, Plane, Segmentation
 from .perception.camera import check_intrinsics
 from .synthesis import Descent, GraspPlan, search
 from .synthesis.grasp_height import check_rule as check_grasp_height
 from .synthesis.grasp_height import grasp_height as choose_grasp_height
-from .tolerances import (APPROACH_OFFSET, HOMOGENEOUS_ROW, MAX_APPROACH_OFFSET, MAX_STANDOFF, ROTATION_TOLERANCE,
-                         SMALL_OBJECT_TOUCHING)
+from .tolerances import APPROACH_OFFSET, HOMOGENEOUS_ROW, MAX_APPROACH_OFFSET, MAX_STANDOFF, ROTATION_TOLERANCE
 
 SEGMENT_CHOICES = perception.SEGMENT_METHODS
 
@@ -122,7 +121,6 @@ def plan_frame(
     slice_contour: bool = False,
     closing_sweep: bool = False,
     closing_obstacles: bool = False,
-    small_objects: bool = False,
     **synthesis_options,
 ) -> ImageGraspPlan:
     """Plan a grasp on one RGB-D frame with a :class:`~contourgrasp.hand.Hand`.
@@ -196,13 +194,6 @@ def plan_frame(
         With ``descent``: also refuse a pose where a finger, closing until it meets the target (or to
         its end, if it misses), would run into a neighbouring object or a bin's wall -- the height
         map's obstacle cells (:func:`contourgrasp.synthesis.sweep.closing_hits`).
-    small_objects : bool
-        The small-object rule: when no pose satisfies the constraints with the hand's
-        ``min_touching`` fingers, plan again with fewer touching fingers, down to
-        ``tolerances.SMALL_OBJECT_TOUCHING`` (the thumb, or the hand's required fingers, against
-        one other): a one-DoF power grasp of a small object closes the whole hand, but only the
-        thumb and the fingers opposite it reach the object. The plan's ``hand`` has the
-        ``min_touching`` it was planned with, and its notes say so.
     **synthesis_options
         Keyword options of :func:`contourgrasp.synthesis.search`.
 
@@ -240,7 +231,7 @@ def plan_frame(
     if validation.flag("slice_contour", slice_contour, error=PlannerError) and asked is not None:
         section = perception.cross_section(heights, asked[0])
         contour = contour if section is None else section
-    plan = _search(contour, hand, spec, small_objects, synthesis_options)
+    plan = search(contour, hand, descent=spec, **synthesis_options)
     tip_height = None if asked is None else asked[0] if plan.descent is None else float(plan.descent.tip_height[0])
     depth_at = (metric.approach_depth if tip_height is None
                 else _palm_depth(metric, heights, hand, plan.pose, tip_height))
@@ -250,24 +241,6 @@ def plan_frame(
     T_base_hand = None if T_base_camera is None else T_base_camera @ T_camera_hand
     return ImageGraspPlan(plan, seg, metric, intrinsics, T_camera_hand, T_camera_pregrasp, T_base_hand, filled,
                           heights, *scene, grasp_height=tip_height)
-
-
-def _search(contour, hand: Hand, descent: Descent | None, small_objects, options) -> GraspPlan:
-    """:func:`~contourgrasp.synthesis.search`, with the small-object rule of :func:`plan_frame` when asked."""
-    small_objects = validation.flag("small_objects", small_objects, error=PlannerError)
-    fewest = max(SMALL_OBJECT_TOUCHING, sum(f.required for f in hand.fingers))
-    try:
-        return search(contour, hand, descent=descent, **options)
-    except NoFeasibleGrasp as err:
-        if not small_objects or hand.min_touching <= fewest:
-            raise
-        first = str(err)
-    for touching in range(hand.min_touching - 1, fewest - 1, -1):
-        try:
-            return search(contour, replace(hand, min_touching=touching), descent=descent, **options)
-        except NoFeasibleGrasp as err:
-            last = str(err)
-    raise NoFeasibleGrasp(f"{first}; with the small-object rule, down to {fewest} touching fingers: {last}")
 
 
 def _grasp_height(hand: Hand, heights: HeightMap | None, descent, grasp_height) -> tuple[float, float] | None:

@@ -4,7 +4,9 @@ The thesis traces the failures on the glasses case to "all grasping points
 laying on the same surface" (chapter 5, failure 2) and proposes a force-closure
 test (section 6.1, item 2). This module provides it, together with the epsilon
 metric of Ferrari & Canny (1992, "Planning optimal grasps", ICRA), which also
-says how far a grasp is from losing closure. Everything here is a pure function
+says how far a grasp is from losing closure, and the squeeze's imbalance
+(:func:`imbalance`): the net force left when every contact pushes equally hard,
+which an underactuated hand cannot correct. Everything here is a pure function
 of numpy arrays; the planner decides how to use the numbers.
 
 Conventions
@@ -88,12 +90,15 @@ class GraspQuality:
     metric : {"L1", "Linf"}
     mu : float
         Friction coefficient used.
+    imbalance : float
+        :func:`imbalance` of the contacts: 0 when equal pushes cancel, 1 when all push one way.
     """
 
     force_closure: bool
     epsilon: float
     metric: str
     mu: float
+    imbalance: float
 
 
 # --------------------------------------------------------------------- public
@@ -183,7 +188,50 @@ def grasp_quality(
     Parameters are those of :func:`epsilon`.
     """
     eps = epsilon(points, normals, mu=mu, centre=centre, rho=rho, metric=metric)
-    return GraspQuality(force_closure=eps > 0.0, epsilon=eps, metric=metric, mu=float(mu))
+    share = float(imbalance(np.asarray(normals, dtype=float)[None])[0])
+    return GraspQuality(force_closure=eps > 0.0, epsilon=eps, metric=metric, mu=float(mu), imbalance=share)
+
+
+def imbalance(normals, valid=None) -> np.ndarray:
+    """The squeeze's net force when every contact pushes with the same force, as a share of their sum.
+
+    An underactuated hand cannot choose its contact forces: one tendon drives every finger, and
+    each finger that touches presses along the surface's normal. Our reading is that they press
+    equally hard, which needs nothing the hand file does not give. The net force
+    ``|sum_i n_i| / k`` over the k contacts must then be carried by friction, or the object
+    squirts out of the closing hand. Force closure says the contacts *could* balance any force
+    with well-chosen forces; this says whether the forces the hand applies balance.
+
+    Parameters
+    ----------
+    normals : (p, n, 2) float
+        Inward normals of p grasps with up to n contacts each (any positive length).
+    valid : (p, n) bool, optional
+        Which contacts exist; invalid entries may hold anything. Default all.
+
+    Returns
+    -------
+    (p,) float
+        In [0, 1]: 0 when the pushes cancel, 1 when every contact pushes the same way; 1 for a
+        grasp without contacts.
+
+    Examples
+    --------
+    Opposite contacts cancel; a thumb against four fingers spread over 120 deg does not:
+
+    >>> import numpy as np
+    >>> float(imbalance([[[1.0, 0.0], [-1.0, 0.0]]])[0])
+    0.0
+    >>> fingers = [[np.cos(a), np.sin(a)] for a in np.radians([-60, -20, 20, 60])]
+    >>> round(float(imbalance([[[-1.0, 0.0], *fingers]])[0]), 3)
+    0.376
+    """
+    points = np.zeros(np.shape(normals))
+    _, n, ok = _check_contact_batch(points, normals, valid)
+    count = ok.sum(axis=1)
+    net = np.linalg.norm(np.where(ok[..., None], n, 0.0).sum(axis=1), axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(count > 0, net / np.maximum(count, 1), 1.0)
 
 
 def epsilon_many(

@@ -22,7 +22,7 @@ def test_presets_load_and_paper_is_the_thesis():
 @pytest.mark.parametrize("name", ["paper", "default"])
 def test_preset_options_are_accepted_by_synthesis(name):
     options = load_planner(name).synthesis_options | {"xy_step": 0.03, "yaw_step": math.radians(15)}
-    plan = search(cg.example_contour("case"), cg.load_hand("three-finger"), **options)
+    plan = search(cg.example_contour("can"), cg.load_hand("three-finger"), **options)
     assert plan.grid.xy_step == 0.03
 
 
@@ -126,7 +126,7 @@ def test_deeply_nested_planner_toml_is_one_planner_file_error():
 @given(content=st.one_of(st.binary(max_size=300), st.text(max_size=300).map(str.encode),
                          st.builds(lambda key, value: f'name = "x"\n{key} = {value}\n'.encode(),
                                    st.sampled_from(["xy_step", "yaw_step", "d_max", "d_min", "harmonics", "friction",
-                                                    "clearance", "quality_gain", "refine"]),
+                                                    "clearance", "quality_gain", "max_imbalance", "refine"]),
                                    st.sampled_from(["1e-300", "1e300", "-1", "0", "nan", "inf", "1000000", '"x"',
                                                     "[0.1, 1e300]", "true", "0.05"]))))
 def test_fuzz_load_planner_on_random_bytes_gives_a_planner_or_a_planner_file_error(tmp_path_factory, content):
@@ -140,8 +140,8 @@ def test_fuzz_load_planner_on_random_bytes_gives_a_planner_or_a_planner_file_err
     assert planner.name == "x"
 
 
-def test_the_3d_keys_are_plan_options_not_search_options():
+def test_the_scene_keys_are_plan_options_not_search_options():
     planner = parse_planner('name = "x"\ndescent = true\ngrasp_height = 0.05\nslice_contour = false\n'
                             'closing_sweep = true\nsmall_objects = true\nxy_step = 0.02', source="mine.toml")
     assert planner.plan_options["grasp_height"] == 0.05 and planner.plan_options["descent"] is True
-    assert planner.synthesis_options == {"xy_step": 0.02}
+    assert planner.synthesis_options == {"small_objects": True, "xy_step": 0.02}  # the rule is the search's

@@ -200,7 +200,8 @@ def test_the_bundled_frame_lists_the_grippers_fingers_as_candidates_not_in_view(
     np.testing.assert_allclose(clicked.T_camera_hand, result.T_camera_hand)
 
 
-#: ``contourgrasp plan`` on examples/bar_clamp with the default hand and planner, on main before issue 17.
+#: ``contourgrasp plan`` on examples/bar_clamp with the default hand and planner, on main before issue 17 (the
+#: squeeze's balance, which came later, is turned off to compare).
 MAIN_POSE = {"x": -0.12883457293878184, "y": -0.018931441854729582, "yaw": 4.60766922526503}
 
 
@@ -214,7 +215,7 @@ def _plan(tmp_path, capsys, *extra):
 def test_cli_plan_on_the_bundled_frame_is_unchanged_and_reports_objects(tmp_path, capsys):
     import json
 
-    code, out, _ = _plan(tmp_path, capsys)
+    code, out, _ = _plan(tmp_path, capsys, "--max-imbalance", "1")
     assert code == 0
     data = json.loads(out.read_text())
     assert data["pose"] == pytest.approx(MAIN_POSE, abs=1e-9)

@@ -162,7 +162,7 @@ def test_random_star_polygons_give_finite_plans_or_documented_errors(polygon, ha
                                            ("d_max", (0.1, 0.1, 0.1)), ("yaw_step", None), ("top_k", 2.5),
                                            ("top_k", True), ("refine", "yes"), ("finger_thickness", 1),
                                            ("require_closure", None), ("clearance", "0"), ("friction", 1e300),
-                                           ("quality_gain", float("nan")), ("harmonics", "many"),
+                                           ("quality_gain", float("nan")), ("max_imbalance", 1.01), ("harmonics", "many"),
                                            ("harmonics", 4.0), ("harmonics", 1_000_000), ("curvature", None),
                                            ("d_max", 1e6), ("xy_step", 1e300)])
 def test_a_wrong_type_or_value_of_any_option_is_a_planner_error_naming_it(option, value):
@@ -206,6 +206,7 @@ option_values = {
     "friction": st.one_of(st.floats(0, 12), absurd),
     "require_closure": st.one_of(st.booleans(), absurd),
     "quality_gain": st.one_of(st.floats(0, 100), absurd),
+    "max_imbalance": st.one_of(st.floats(0, 1), absurd),
 }
 
 
@@ -221,3 +222,15 @@ def test_fuzz_synthesize_returns_a_plan_or_a_clear_error(options, scale, hand, p
         return
     assert np.all(np.isfinite(plan.pose)) and np.isfinite(plan.cost.total)
     assert plan.grid_size <= cg.tolerances.MAX_GRID_POSES
+
+
+def test_the_small_object_rule_plans_fewer_touching_fingers_and_says_why_when_it_cannot():
+    theta = np.linspace(0, 2 * np.pi, 200, endpoint=False)
+    disc = 0.02 * np.stack([np.cos(theta), np.sin(theta)], axis=1)  # 4 cm: too small for four fingers
+    grid = {"yaw_step": math.radians(10), "xy_step": 0.01}
+    with pytest.raises(cg.NoFeasibleGrasp, match="no pose brings 4 fingers"):
+        cg.synthesize(disc, "five-finger-linear", **grid)
+    plan = cg.synthesize(disc, "five-finger-linear", small_objects=True, **grid)
+    assert plan.hand.min_touching == 2 and sum(not f.missed for f in plan.fingers) == 2
+    with pytest.raises(cg.NoFeasibleGrasp, match="with the small-object rule, down to 2 touching fingers: no pose"):
+        cg.synthesize(disc / 7, "five-finger-linear", small_objects=True, **grid)

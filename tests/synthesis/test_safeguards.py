@@ -1,4 +1,4 @@
-"""Safeguards beyond the thesis: finger thickness and grasp quality in the synthesis."""
+"""Safeguards beyond the thesis: finger thickness, grasp quality and the squeeze's balance in the synthesis."""
 
 import dataclasses
 import math
@@ -104,7 +104,51 @@ def test_required_closure_holds_or_is_refused():
         cg.synthesize(circle(0.03), lone, require_closure=True, **FAST)
 
 
-@pytest.mark.parametrize("option", [{"clearance": -0.01}, {"friction": float("nan")}, {"quality_gain": -1.0}])
+def test_a_balanced_squeeze_is_planned_when_one_exists():
+    # four fingers along one side of the case outpush the thumb; the thumb against one or two balances
+    contour = cg.example_contour("case")
+    hand = dataclasses.replace(cg.load_hand("five-finger-linear"), min_touching=2)
+    free = cg.synthesize(contour, hand, require_closure=True, **FAST)
+    assert free.quality.imbalance > 0.5
+    balanced = cg.synthesize(contour, hand, require_closure=True, max_imbalance=0.25, **FAST)
+    assert balanced.quality.imbalance <= 0.25 and balanced.safeguards.max_imbalance == 0.25
+    assert balanced.cost.total >= free.cost.total  # the cheapest pose passing it costs no less
+    assert balanced.notes == ()
+
+
+def test_without_a_balanced_pose_the_plan_is_the_unbalanced_best_and_says_so():
+    contour, hand = cg.example_contour("case"), cg.load_hand("five-finger-linear")  # four fingers must touch
+    free = cg.synthesize(contour, hand, require_closure=True, **FAST)
+    plan = cg.synthesize(contour, hand, require_closure=True, max_imbalance=0.25, **FAST)
+    np.testing.assert_array_equal(plan.pose, free.pose)
+    assert plan.safeguards.max_imbalance == 0.25 and plan.quality.imbalance == free.quality.imbalance > 0.25
+    assert plan.notes == (f"no pose balances the squeeze within max_imbalance = 0.25: planned without it; with every "
+                          f"finger pushing equally hard, {free.quality.imbalance:.2f} of their force is left to "
+                          "friction",)
+
+
+def test_the_no_grasp_reason_names_the_squeeze():
+    from contourgrasp.synthesis.evaluate import evaluate_poses
+    from contourgrasp.synthesis.outer import _diagnose_exact
+
+    lone = one_finger((-0.08, 0.0), (1.0, 0.0), radius=0.0)  # one finger pushes alone: all its force is left over
+    guards = Safeguards(max_imbalance=0.5)
+    result = evaluate_poses(cg.contour.fit(circle(0.03), 4), lone, np.zeros((1, 3)), safeguards=guards)
+    assert result.touching.all() and not result.feasible.any()
+    assert _diagnose_exact(result, guards) == (
+        "none of the 1 poses that reach the object balances the squeeze: with every finger pushing equally hard, "
+        "the least net force left is 1.00 of their sum (max_imbalance = 0.5)")
+
+
+def test_two_opposed_fingers_balance_a_disc():
+    pair = Hand("pair", (Finger("a", start=(-0.06, 0.0), trajectory=Ray((1.0, 0.0)), travel=0.1),
+                         Finger("b", start=(0.06, 0.0), trajectory=Ray((-1.0, 0.0)), travel=0.1)), min_touching=2)
+    plan = cg.synthesize(circle(0.03), pair, max_imbalance=1e-6, **FAST)
+    assert plan.quality.imbalance == pytest.approx(0.0, abs=1e-6)
+
+
+@pytest.mark.parametrize("option", [{"clearance": -0.01}, {"friction": float("nan")}, {"quality_gain": -1.0},
+                                    {"max_imbalance": 1.5}, {"max_imbalance": -0.1}])
 def test_bad_safeguards_are_refused_by_name(option):
     with pytest.raises(InputError, match=next(iter(option))):
         Safeguards(**option)

@@ -24,12 +24,13 @@ which is the thesis's setting)::
     friction = 0.5
     require_closure = false
     quality_gain = 0.0
+    max_imbalance = 1.0          # refuse poses whose equal finger pushes leave more net force (1: off)
     descent = false              # the open 3-D hand's descent onto the height map (synthesis.Descent)
     grasp_height = "clearance"   # or "auto", or a height in m (synthesis.grasp_height)
     slice_contour = false        # plan on the cross-section at the grasp height (perception.cross_section)
     closing_sweep = false        # refuse poses where a finger's link meets the object before its tip (synthesis.sweep)
     closing_obstacles = false    # refuse poses where a closing finger runs into a neighbour or a bin wall
-    small_objects = false        # fewer touching fingers where no pose brings min_touching onto the object
+    small_objects = false        # fewer touching fingers where no pose satisfies the constraints (synthesis.search)
 
 Unknown keys, wrong types and impossible values are refused with
 :class:`PlannerFileError` naming the file and the field; so is a file that is not UTF-8 text or
@@ -53,7 +54,7 @@ _PRESET_DIR = "data/planners"
 #: Options that belong to perception, and to planning in the scene's 3-D (the rest are
 #: :func:`contourgrasp.synthesis.search`'s).
 PERCEPTION_OPTIONS = ("depth_mode", "footprint")
-SCENE_OPTIONS = ("descent", "grasp_height", "slice_contour", "closing_sweep", "closing_obstacles", "small_objects")
+SCENE_OPTIONS = ("descent", "grasp_height", "slice_contour", "closing_sweep", "closing_obstacles")
 
 Positive = Annotated[float, Field(gt=0, le=tol.MAX_SEARCH_LENGTH, allow_inf_nan=False)]
 Distance = Annotated[float, Field(ge=0, le=tol.MAX_SEARCH_LENGTH, allow_inf_nan=False)]
@@ -79,6 +80,7 @@ class _PlannerSchema(BaseModel):
     friction: Annotated[float, Field(ge=0, le=tol.MAX_FRICTION, allow_inf_nan=False)] | None = None
     require_closure: bool | None = None
     quality_gain: NonNegative | None = None
+    max_imbalance: Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] | None = None
     descent: bool | None = None
     slice_contour: bool | None = None
     closing_sweep: bool | None = None

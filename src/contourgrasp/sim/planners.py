@@ -66,6 +66,7 @@ ABLATION_STEPS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("sweep", ("closing_sweep",)),
     ("small", ("small_objects",)),
     ("closing", ("closing_obstacles",)),
+    ("balance", ("max_imbalance",)),
 )
 #: Baseline planners without synthesis: name -> what it does (module docstring).
 BASELINES = {

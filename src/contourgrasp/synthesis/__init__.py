@@ -6,7 +6,7 @@
 * :mod:`~contourgrasp.synthesis.cost` — the outer problem's cost (eq 3.34-3.38,
   :func:`ratio_cost`) and its constraint on the fingers' starts (eq 3.41);
 * :mod:`~contourgrasp.synthesis.safeguards` — constraints beyond the thesis's (:class:`Safeguards`,
-  :func:`fingers_clear`, :func:`grasp_epsilon`);
+  :func:`fingers_clear`, :func:`grasp_epsilon`, :func:`grasp_imbalance`);
 * :mod:`~contourgrasp.synthesis.evaluate` — inner problem and cost exactly at any poses
   (:func:`evaluate_poses`);
 * :mod:`~contourgrasp.synthesis.grid` — the pose grid (eq 3.33, 3.39-3.40, :class:`SearchGrid`), its
@@ -28,10 +28,10 @@ from .inner import closest_approach, first_touch
 from .outer import search
 from .plan import Alternative, Cost, FingerContact, GraspPlan, PoseEvaluation, Refinement
 from .refine import refine_poses
-from .safeguards import Safeguards, fingers_clear, grasp_epsilon
+from .safeguards import Safeguards, fingers_clear, grasp_epsilon, grasp_imbalance
 
 __all__ = [
     "Alternative", "Cost", "Descent", "DescentCheck", "FingerContact", "GraspPlan", "PoseEvaluation", "Refinement", "Safeguards",
     "SearchGrid", "closest_approach", "descent_clearance", "descent_feasible", "descent_floor", "distance", "distinct_best", "evaluate_poses", "fingers_clear",
-    "first_touch", "grasp_epsilon", "ratio_cost", "refine_poses", "screen_grid", "search",
+    "first_touch", "grasp_epsilon", "grasp_imbalance", "ratio_cost", "refine_poses", "screen_grid", "search",
 ]

@@ -82,7 +82,7 @@ def distance(p_virt, p_grasp):
 
 
 def score(hand: Hand, poses, touching, lam, t, point, curv, start_inside, d_min, clear, epsilon,
-          safeguards: Safeguards, n_yaw: int | None = None) -> PoseEvaluation:
+          safeguards: Safeguards, n_yaw: int | None = None, *, imbalance=None) -> PoseEvaluation:
     """Constraints and cost of each pose from the inner problem's solutions.
 
     Implements eq 3.34 and 3.41: the cost f = sum_i alpha_i C_curvature(t_i) + C_ratio
@@ -90,7 +90,7 @@ def score(hand: Hand, poses, touching, lam, t, point, curv, start_inside, d_min,
     each pose: no fingertip starts inside the contour, every required finger and at least
     ``hand.min_touching`` touch, every touching finger starts at least D_min from its grasp point
     (eq 3.41, dist(t_i, 0) of :func:`distance`), plus the :class:`Safeguards`' constraints
-    (``clear``, force closure) and cost (``-quality_gain * epsilon``).
+    (``clear``, force closure, the squeeze's balance) and cost (``-quality_gain * epsilon``).
 
     Parameters
     ----------
@@ -110,6 +110,8 @@ def score(hand: Hand, poses, touching, lam, t, point, curv, start_inside, d_min,
     safeguards : Safeguards
     n_yaw : int, optional
         The period of the poses' yaws, for a grid (yaw fastest); None for any list of poses.
+    imbalance : (p,) float, optional
+        :func:`contourgrasp.quality.imbalance` of the grasp points (NaN or None: not computed).
 
     Returns
     -------
@@ -124,6 +126,9 @@ def score(hand: Hand, poses, touching, lam, t, point, curv, start_inside, d_min,
     feasible = outside & reaches & far_enough & clear
     if safeguards.require_closure:
         feasible &= epsilon > 0
+    imbalance = np.full(len(poses), np.nan) if imbalance is None else np.asarray(imbalance, dtype=float)
+    if safeguards.balances:
+        feasible &= imbalance <= safeguards.max_imbalance
     cost_quality = -safeguards.quality_gain * np.nan_to_num(epsilon) if safeguards.quality_gain else np.zeros(len(poses))
     return PoseEvaluation(
         poses=poses,
@@ -139,6 +144,7 @@ def score(hand: Hand, poses, touching, lam, t, point, curv, start_inside, d_min,
         reaches=reaches,
         clear=clear,
         epsilon=epsilon,
+        imbalance=imbalance,
         feasible=feasible,
         cost_curvature=cost_curvature,
         cost_ratio=cost_ratio,

@@ -16,7 +16,7 @@ from ._derived import polygon
 from .cost import score
 from .inner import solve
 from .plan import PoseEvaluation
-from .safeguards import Safeguards, fingers_clear, grasp_epsilon
+from .safeguards import Safeguards, fingers_clear, grasp_epsilon, grasp_imbalance
 
 
 def evaluate_poses(
@@ -78,7 +78,9 @@ def evaluate_poses(
     epsilon = np.full(len(poses), np.nan)
     if safeguards.grades_quality:
         epsilon = grasp_epsilon(model, point, t, touching, friction=safeguards.friction)
-    return score(hand, poses, touching, lam, t, point, curv, start_inside, d_min, clear, epsilon, safeguards)
+    imbalance = grasp_imbalance(model, t, touching) if safeguards.balances else np.full(len(poses), np.nan)
+    return score(hand, poses, touching, lam, t, point, curv, start_inside, d_min, clear, epsilon, safeguards,
+                 imbalance=imbalance)
 
 
 def replace_rows(evaluation: PoseEvaluation, rows, source: PoseEvaluation, source_rows) -> PoseEvaluation:

@@ -41,7 +41,7 @@ from .grid import SearchGrid, distinct_best, screen_grid
 from .inner import closest_approach
 from .plan import Alternative, Cost, FingerContact, GraspPlan, PoseEvaluation, Refinement
 from .refine import refine_poses
-from .safeguards import Safeguards, grasp_epsilon
+from .safeguards import Safeguards, grasp_epsilon, grasp_imbalance
 
 
 def search(
@@ -61,6 +61,8 @@ def search(
     friction: float = 0.5,
     require_closure: bool = False,
     quality_gain: float = 0.0,
+    max_imbalance: float = 1.0,
+    small_objects: bool = False,
     descent: Descent | None = None,
 ) -> GraspPlan:
     """Plan a grasp on a contour: fit the EFD model, search the pose grid, return the best pose.
@@ -91,9 +93,21 @@ def search(
         After the grid, refine its best ``tol.REFINE_STARTS`` distinct poses continuously
         (:func:`~contourgrasp.synthesis.refine_poses`, under the same constraints) and keep the
         better; ``refinement`` reports the gain.
-    finger_thickness, clearance, friction, require_closure, quality_gain
+    finger_thickness, clearance, friction, require_closure, quality_gain, max_imbalance
         The :class:`~contourgrasp.synthesis.Safeguards` (all off: the thesis's problem).
         ``friction`` is also the mu of the plan's reported ``quality``.
+    max_imbalance : float
+        A balanced squeeze is preferred, not required: when no pose meets it (with the small-object
+        rule's fewer fingers too), the search is repeated without it, and the plan's notes say so.
+    small_objects : bool
+        The small-object rule: when no pose satisfies the constraints with the hand's
+        ``min_touching`` fingers, search again with fewer touching fingers, down to
+        ``tolerances.SMALL_OBJECT_TOUCHING`` (the thumb, or the hand's required fingers, against
+        one other). A one-DoF power grasp of a small object closes the whole hand, but only the
+        thumb and the fingers opposite it reach the object. With ``max_imbalance`` the same rule
+        plans the thumb against the one or two fingers that balance it on objects of any size
+        (four fingers along one side outpush one thumb). The plan's ``hand`` has the
+        ``min_touching`` it was planned with.
     descent : Descent, optional
         The scene's height map and the grasp height: a pose is feasible only if the open hand,
         lowered along the approach axis until its lowest fingertip is at ``descent.tip_height``,
@@ -135,14 +149,54 @@ def search(
     safeguards = Safeguards(finger_thickness=check.flag("finger_thickness", finger_thickness, error=PlannerError),
                             clearance=clearance, friction=friction,
                             require_closure=check.flag("require_closure", require_closure, error=PlannerError),
-                            quality_gain=quality_gain)
+                            quality_gain=quality_gain, max_imbalance=max_imbalance)
 
     clock = time.perf_counter()
+    small_objects = check.flag("small_objects", small_objects, error=PlannerError)
     contour = efd_model.clean_polygon(contour_xy)
     if harmonics == "adaptive":
         harmonics = efd_model.choose_harmonics(contour, validate=False)
     model = efd_model.fit(contour, harmonics, validate=False)
     fitted = time.perf_counter()
+    fewest = max(tol.SMALL_OBJECT_TOUCHING, sum(f.required for f in hand.fingers))
+    fewest = min(fewest, hand.min_touching) if small_objects else hand.min_touching
+    counts = range(hand.min_touching, fewest - 1, -1)
+    attempts = [(touching, safeguards) for touching in counts]
+    if safeguards.balances:  # a balanced squeeze is preferred, not required: then the thesis's best pose
+        attempts += [(touching, replace(safeguards, max_imbalance=1.0)) for touching in counts]
+    errors = []
+    for touching, guards in attempts:
+        try:
+            plan = _search_fitted(model, contour, replace(hand, min_touching=touching), grid, guards, descent,
+                                  curvature=curvature, top_k=top_k, refine=refine, clock=clock, fitted=fitted)
+        except NoFeasibleGrasp as err:
+            errors.append(str(err))
+            continue
+        if guards is not safeguards:
+            note = NOTE_UNBALANCED.format(limit=safeguards.max_imbalance, share=plan.quality.imbalance)
+            plan = replace(plan, safeguards=safeguards, search_notes=(note,))
+        return plan
+    raise NoFeasibleGrasp(_no_grasp(errors, len(counts), fewest))
+
+
+#: The note of a plan whose squeeze no pose could balance within ``max_imbalance``.
+NOTE_UNBALANCED = ("no pose balances the squeeze within max_imbalance = {limit:g}: planned without it; with every "
+                   "finger pushing equally hard, {share:.2f} of their force is left to friction")
+
+
+def _no_grasp(errors: list[str], counts: int, fewest: int) -> str:
+    """The first attempt's reason, the small-object rule's last, and the search without the squeeze's balance."""
+    message = errors[0]
+    if counts > 1:
+        message += f"; with the small-object rule, down to {fewest} touching fingers: {errors[counts - 1]}"
+    if len(errors) > counts:
+        message += f"; without the squeeze's balance: {errors[-1]}"
+    return message
+
+
+def _search_fitted(model: EFD, contour, hand: Hand, grid: SearchGrid, safeguards: Safeguards,
+                   descent: Descent | None, *, curvature, top_k, refine, clock, fitted) -> GraspPlan:
+    """:func:`search` for one ``hand.min_touching`` on a fitted model."""
     screen = screen_grid(model, hand, grid, curvature=curvature)
     searched = time.perf_counter()
     if not screen.feasible.any():
@@ -169,7 +223,7 @@ def search(
     best = ranked[0]
     descended = None if descent is None else _descended(hand, descent, result.poses[best:best + 1])
     fingers = _contacts(model, hand, result, best, curvature)
-    grasp_quality = _quality(model, result, best, friction)
+    grasp_quality = _quality(model, result, best, safeguards.friction)
     timing = {
         "efd": 1e3 * (fitted - clock),
         "search": 1e3 * (searched - fitted),
@@ -281,20 +335,29 @@ def _diagnose_exact(result: PoseEvaluation, safeguards: Safeguards) -> str:
                 f"{safeguards.clearance} m to the object or striking it before its grasp point")
     if safeguards.require_closure and not (result.epsilon > 0).any():
         return f"none of the {n} poses that reach the object puts its grasp points in force closure"
+    balanced = (result.epsilon > 0) if safeguards.require_closure else np.ones(n, bool)
+    if safeguards.balances and not (balanced & (result.imbalance <= safeguards.max_imbalance)).any():
+        best = float(np.nanmin(np.where(balanced, result.imbalance, np.nan), initial=1.0))
+        return (f"none of the {n} poses that reach the object balances the squeeze: with every finger pushing "
+                f"equally hard, the least net force left is {best:.2f} of their sum (max_imbalance = "
+                f"{safeguards.max_imbalance:g})")
     return ("every pose that reaches the object fails a constraint once its contacts are "
             "computed on the EFD curve itself rather than its polygon")
 
 
 def _quality(model: EFD, result: PoseEvaluation, i: int, friction: float) -> quality.GraspQuality:
-    """Force closure and L1 epsilon of pose i's grasp points (as :func:`grasp_epsilon` grades them).
+    """Force closure, L1 epsilon and imbalance of pose i's grasp points (as the safeguards grade them).
 
-    The evaluation's own epsilon when the safeguards needed it (same friction and convention), else computed.
+    The evaluation's own values when the safeguards needed them (same friction and convention), else computed.
     """
-    eps = float(result.epsilon[i])
+    rows = slice(i, i + 1)
+    eps, share = float(result.epsilon[i]), float(result.imbalance[i])
     if np.isnan(eps):
-        eps = float(grasp_epsilon(model, result.grasp_point[i:i + 1], result.t[i:i + 1], result.touching[i:i + 1],
+        eps = float(grasp_epsilon(model, result.grasp_point[rows], result.t[rows], result.touching[rows],
                                   friction=friction)[0])
-    return quality.GraspQuality(force_closure=eps > 0, epsilon=eps, metric="L1", mu=float(friction))
+    if np.isnan(share):
+        share = float(grasp_imbalance(model, result.t[rows], result.touching[rows])[0])
+    return quality.GraspQuality(force_closure=eps > 0, epsilon=eps, metric="L1", mu=float(friction), imbalance=share)
 
 
 def _cost(result: PoseEvaluation, i: int) -> Cost:

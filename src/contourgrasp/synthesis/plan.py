@@ -48,6 +48,9 @@ class PoseEvaluation:
         The fingers pass :class:`Safeguards` ``finger_thickness`` (all True when it is off).
     epsilon : (p,) float
         Ferrari-Canny epsilon of the grasp points (NaN where not computed).
+    imbalance : (p,) float
+        The squeeze's imbalance at the grasp points (:func:`contourgrasp.quality.imbalance`; NaN
+        where not computed).
     feasible : (p,) bool
     cost_curvature, cost_ratio, cost_miss, cost_quality, cost : (p,) float
     """
@@ -65,6 +68,7 @@ class PoseEvaluation:
     reaches: np.ndarray
     clear: np.ndarray
     epsilon: np.ndarray
+    imbalance: np.ndarray
     feasible: np.ndarray
     cost_curvature: np.ndarray
     cost_ratio: np.ndarray
@@ -171,8 +175,10 @@ class GraspPlan:
     descent : DescentCheck or None
         The descent check of ``pose`` (one row: each finger's body's and the palm's clearance over
         the height map); None when the search had no :class:`~contourgrasp.synthesis.Descent`.
+    search_notes : tuple of str
+        What the search had to give up (e.g. :data:`~contourgrasp.synthesis.outer.NOTE_UNBALANCED`).
     notes : tuple of str
-        What the plan could not take into account (a property: see :func:`plan_notes`).
+        What the plan could not take into account (a property: :func:`plan_notes`, then ``search_notes``).
     """
 
     pose: np.ndarray
@@ -191,11 +197,12 @@ class GraspPlan:
     safeguards: Safeguards
     quality: GraspQuality
     descent: DescentCheck | None = None
+    search_notes: tuple[str, ...] = ()
 
     @property
     def notes(self) -> tuple[str, ...]:
-        """Notes on what the plan could not take into account (:func:`plan_notes`)."""
-        return plan_notes(self.hand)
+        """Notes on what the plan could not take into account (:func:`plan_notes`, then ``search_notes``)."""
+        return plan_notes(self.hand) + self.search_notes
 
 
 #: The note of a plan made with a hand that has no 3-D geometry.

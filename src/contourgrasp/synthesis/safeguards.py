@@ -2,7 +2,8 @@
 
 Finger thickness (:func:`fingers_clear`, failure 5: a finger striking the object on its way) and
 grasp quality (:func:`grasp_epsilon`, failure 2: "all grasping points on the same surface";
-6.1 item 2). All off, :class:`Safeguards` is the thesis's problem.
+6.1 item 2) and the squeeze's balance (:func:`grasp_imbalance`, failure 1: the object pushed
+away before every finger touches). All off, :class:`Safeguards` is the thesis's problem.
 """
 
 from __future__ import annotations
@@ -51,6 +52,12 @@ class Safeguards:
     quality_gain : float
         Cost term ``-quality_gain * epsilon`` (Ferrari-Canny L1, wrenches about
         the EFD locus, torque over the contour's largest radius about it).
+    max_imbalance : float
+        Reject poses whose equal pushes along the grasp points' normals leave a net force of
+        more than this share of their sum (:func:`contourgrasp.quality.imbalance`; in [0, 1],
+        1 = off). Force closure says the contacts *could* hold the object; an underactuated
+        hand does not choose its forces, and an unbalanced squeeze pushes the object away
+        before the last finger arrives or slides it out as the fingers close.
 
     Raises
     ------
@@ -63,6 +70,7 @@ class Safeguards:
     friction: float = 0.5
     require_closure: bool = False
     quality_gain: float = 0.0
+    max_imbalance: float = 1.0
 
     def __post_init__(self):
         check.flag("finger_thickness", self.finger_thickness, error=PlannerError)
@@ -70,6 +78,12 @@ class Safeguards:
         check.friction("friction", self.friction, tol.MAX_FRICTION, error=PlannerError)
         check.flag("require_closure", self.require_closure, error=PlannerError)
         check.non_negative("quality_gain", self.quality_gain, error=PlannerError)
+        check.bounded("max_imbalance", self.max_imbalance, 1.0, "", error=PlannerError)
+
+    @property
+    def balances(self) -> bool:
+        """The squeeze's imbalance is a constraint."""
+        return self.max_imbalance < 1.0
 
     @property
     def grades_quality(self) -> bool:
@@ -147,7 +161,24 @@ def grasp_epsilon(model: EFD, grasp_point, t, touching, *, friction: float = 0.5
     touching : (p, f) bool
     friction : float
     """
-    normals = quality.contour_normals(model, np.where(touching, t, 0.0))
-    valid = touching & np.isfinite(normals).all(axis=-1)
+    normals, valid = _normals(model, t, touching)
     rho = cached(model, "rho", lambda: float(np.linalg.norm(polygon(model)[1] - model.locus, axis=1).max()))
     return quality.epsilon_many(grasp_point, normals, valid, mu=friction, centre=model.locus, rho=rho)
+
+
+def grasp_imbalance(model: EFD, t, touching) -> np.ndarray:
+    """(p,) float: :func:`contourgrasp.quality.imbalance` of each pose's grasp points on the EFD contour.
+
+    Parameters
+    ----------
+    model : EFD
+    t : (p, f) float
+    touching : (p, f) bool
+    """
+    return quality.imbalance(*_normals(model, t, touching))
+
+
+def _normals(model: EFD, t, touching) -> tuple[np.ndarray, np.ndarray]:
+    """Inward normals (p, f, 2) at the touching fingers' grasp points, and where they exist (p, f)."""
+    normals = quality.contour_normals(model, np.where(touching, t, 0.0))
+    return normals, touching & np.isfinite(normals).all(axis=-1)

@@ -179,18 +179,3 @@ def _near_obstacles(hand: Hand, cell: float, centres, pose, reaches) -> np.ndarr
 def _sweep_points(chain: FingerChain) -> np.ndarray:
     """(k, 2) float: the (x, y) of the capsules' ends over the finger's whole closing, hand frame."""
     return _swept_capsules(chain, float(_travel(chain)[1][-1]))[..., :2].reshape(-1, 2)
-    c, s = np.cos(pose[2]), np.sin(pose[2])
-    for f, (chain, reach) in enumerate(zip(hand.chains, reaches)):
-        if not reach > 0:
-            continue
-        ends = _swept_capsules(chain, float(reach))[..., :2].reshape(-1, 2)
-        placed = np.asarray(pose[:2], dtype=float) + ends @ np.array([[c, s], [-s, c]])
-        grow = chain.radius + cell
-        low, high = placed.min(axis=0) - grow, placed.max(axis=0) + grow
-        near[f] = bool(np.any(np.all((centres >= low) & (centres <= high), axis=1)))
-    return near
-    ends = np.concatenate(ends)
-    radii = np.array([hand.chains[f].radius for f in owner], dtype=float)
-    out = map_clearances(heights, hand, np.asarray(pose, dtype=float)[None], np.array([base], dtype=float), ends, radii)
-    np.logical_or.at(early, np.asarray(owner), out[0, :-1] < 0.0)
-    return early
