@@ -152,3 +152,13 @@ def test_two_opposed_fingers_balance_a_disc():
 def test_bad_safeguards_are_refused_by_name(option):
     with pytest.raises(InputError, match=next(iter(option))):
         Safeguards(**option)
+
+
+def test_a_squeeze_no_screened_pose_balances_is_refused_before_exact_evaluation_then_planned_without():
+    lone = one_finger((-0.08, 0.0), (1.0, 0.0), radius=0.0)
+    with pytest.raises(NoFeasibleGrasp, match=r"^none of the \d+ poses that reach the object balances the squeeze.*"
+                                              r"least net force left is 1.00.*; without the squeeze's balance: .*"
+                                              "force closure"):
+        cg.synthesize(circle(0.03), lone, max_imbalance=0.5, require_closure=True, **FAST)
+    plan = cg.synthesize(circle(0.03), lone, max_imbalance=0.5, **FAST)
+    assert plan.quality.imbalance == 1.0 and "no pose balances the squeeze" in plan.notes[0]

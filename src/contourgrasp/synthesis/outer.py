@@ -265,9 +265,15 @@ def _reevaluate_best(model, hand, screen: PoseEvaluation, n: int, curvature, d_m
     """Exact evaluation of the n cheapest screened poses, then 4n, 16n, ... until one is feasible.
 
     With ``descent``, feasible also means the open hand descends clear (checked in increasing cost,
-    each pose once, at most ``tolerances.MAX_DESCENT_POSES`` in all).
+    each pose once, at most ``tolerances.MAX_DESCENT_POSES`` in all). With the squeeze's balance, only
+    poses whose screened contacts balance within ``tolerances.IMBALANCE_SCREEN`` of it are evaluated.
     """
     feasible = np.flatnonzero(screen.feasible)
+    if safeguards.balances:  # screened on the polygon's contacts: the exact check below decides
+        share = grasp_imbalance(model, screen.t[feasible], screen.touching[feasible])
+        if not (share <= safeguards.max_imbalance + tol.IMBALANCE_SCREEN).any():
+            raise NoFeasibleGrasp(_unbalanced(len(feasible), float(share.min(initial=1.0)), safeguards))
+        feasible = feasible[share <= safeguards.max_imbalance + tol.IMBALANCE_SCREEN]
     order = feasible[np.argsort(screen.cost[feasible], kind="stable")]
     checked, descended, last = 0, 0, None
     while True:
@@ -337,12 +343,15 @@ def _diagnose_exact(result: PoseEvaluation, safeguards: Safeguards) -> str:
         return f"none of the {n} poses that reach the object puts its grasp points in force closure"
     balanced = (result.epsilon > 0) if safeguards.require_closure else np.ones(n, bool)
     if safeguards.balances and not (balanced & (result.imbalance <= safeguards.max_imbalance)).any():
-        best = float(np.nanmin(np.where(balanced, result.imbalance, np.nan), initial=1.0))
-        return (f"none of the {n} poses that reach the object balances the squeeze: with every finger pushing "
-                f"equally hard, the least net force left is {best:.2f} of their sum (max_imbalance = "
-                f"{safeguards.max_imbalance:g})")
+        return _unbalanced(n, float(np.nanmin(np.where(balanced, result.imbalance, np.nan), initial=1.0)), safeguards)
     return ("every pose that reaches the object fails a constraint once its contacts are "
             "computed on the EFD curve itself rather than its polygon")
+
+
+def _unbalanced(n: int, best: float, safeguards: Safeguards) -> str:
+    return (f"none of the {n} poses that reach the object balances the squeeze: with every finger pushing "
+            f"equally hard, the least net force left is {best:.2f} of their sum (max_imbalance = "
+            f"{safeguards.max_imbalance:g})")
 
 
 def _quality(model: EFD, result: PoseEvaluation, i: int, friction: float) -> quality.GraspQuality:
