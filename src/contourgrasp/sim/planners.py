@@ -51,9 +51,10 @@ from ..errors import HandError, NoFeasibleGrasp, SimulationError
 from ..hand import Hand, Ray, to_image
 from ..io.planner_file import Planner, load_planner, planner_names
 
-#: The ablation from ``paper`` to ``default``: each step takes ``default``'s values of these options. The last
-#: five are the 3-D hand's (issue 16): finger bodies against the height map (with the executor's old grasp
-#: height), the planned grasp height, the cross-section at that height, the closing sweep, the small-object rule.
+#: The ablation from ``paper`` to ``default``: each step takes ``default``'s values of these options. Then come
+#: the 3-D hand's five (issue 16): finger bodies against the height map (with the executor's old grasp height),
+#: the planned grasp height, the cross-section at that height, the closing sweep, the small-object rule; the
+#: closing fingers kept clear of obstacles (issue 17); the squeeze's balance.
 ABLATION_STEPS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("grid", ("xy_step", "yaw_step", "d_max", "d_min")),
     ("quality", ("friction", "require_closure", "quality_gain")),
