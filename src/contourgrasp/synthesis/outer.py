@@ -164,11 +164,14 @@ def search(
     attempts = [(touching, safeguards) for touching in counts]
     if safeguards.balances:  # a balanced squeeze is preferred, not required: then the thesis's best pose
         attempts += [(touching, replace(safeguards, max_imbalance=1.0)) for touching in counts]
+    screen = screen_grid(model, replace(hand, min_touching=fewest), grid, curvature=curvature)
+    searched = time.perf_counter()
     errors = []
     for touching, guards in attempts:
         try:
-            plan = _search_fitted(model, contour, replace(hand, min_touching=touching), grid, guards, descent,
-                                  curvature=curvature, top_k=top_k, refine=refine, clock=clock, fitted=fitted)
+            plan = _search_fitted(model, contour, replace(hand, min_touching=touching), _needing(screen, touching),
+                                  grid, guards, descent, curvature=curvature, top_k=top_k, refine=refine,
+                                  times=(clock, fitted, searched))
         except NoFeasibleGrasp as err:
             errors.append(str(err))
             continue
@@ -194,11 +197,25 @@ def _no_grasp(errors: list[str], counts: int, fewest: int) -> str:
     return message
 
 
-def _search_fitted(model: EFD, contour, hand: Hand, grid: SearchGrid, safeguards: Safeguards,
-                   descent: Descent | None, *, curvature, top_k, refine, clock, fitted) -> GraspPlan:
-    """:func:`search` for one ``hand.min_touching`` on a fitted model."""
-    screen = screen_grid(model, hand, grid, curvature=curvature)
-    searched = time.perf_counter()
+def _needing(screen: PoseEvaluation, touching: int) -> PoseEvaluation:
+    """The screen of the fewest touching fingers, feasible only where at least ``touching`` fingers touch.
+
+    Nothing else in the screen depends on ``min_touching``: one screen serves every count the
+    small-object rule tries.
+    """
+    enough = screen.touching.sum(axis=1) >= touching
+    return replace(screen, reaches=screen.reaches & enough, feasible=screen.feasible & enough)
+
+
+def _search_fitted(model: EFD, contour, hand: Hand, screen: PoseEvaluation, grid: SearchGrid,
+                   safeguards: Safeguards, descent: Descent | None, *, curvature, top_k, refine,
+                   times) -> GraspPlan:
+    """:func:`search` for one ``hand.min_touching`` on a fitted model and its screened grid.
+
+    ``times``: the clock at the search's start, after the fit and after the screen (``timing_ms``'s
+    ``exact`` includes earlier counts' exact evaluations).
+    """
+    clock, fitted, searched = times
     if not screen.feasible.any():
         raise NoFeasibleGrasp(_diagnose(screen, hand, grid))
     result = _reevaluate_best(model, hand, screen, max(tol.REFINE_CANDIDATES, 4 * top_k), curvature, grid.d_min,
