@@ -32,8 +32,10 @@ def test_hands_lists_the_presets(capsys):
 
 def test_synth_writes_json_and_png(tmp_path, capsys):
     out_json, out_png = tmp_path / "plan.json", tmp_path / "plan.png"
+    # --max-imbalance 1: the balanced poses of the three-finger hand on the case are too few for 4 alternatives
     code, out, err = run(capsys, "synth", "--contour", "example:case", "--hand", "three-finger", *FAST,
-                         "--out", out_json, "--plot", out_png, "--top-k", "4", "--d-max", "0.1", "0.12")
+                         "--out", out_json, "--plot", out_png, "--top-k", "4", "--d-max", "0.1", "0.12",
+                         "--max-imbalance", "1")
     assert code == 0, err
     data = json.loads(out_json.read_text())
     assert data["hand"] == "three-finger" and len(data["alternatives"]) == 4
