@@ -32,7 +32,7 @@ def test_hands_lists_the_presets(capsys):
 
 def test_synth_writes_json_and_png(tmp_path, capsys):
     out_json, out_png = tmp_path / "plan.json", tmp_path / "plan.png"
-    # --max-imbalance 1: the balanced poses of the three-finger hand on the case are too few for 4 alternatives
+    # --max-imbalance 1: with the balance, the exact evaluation stops at candidates too few for 4 distinct alternatives
     code, out, err = run(capsys, "synth", "--contour", "example:case", "--hand", "three-finger", *FAST,
                          "--out", out_json, "--plot", out_png, "--top-k", "4", "--d-max", "0.1", "0.12",
                          "--max-imbalance", "1")
