@@ -57,7 +57,9 @@ class Safeguards:
         more than this share of their sum (:func:`contourgrasp.quality.imbalance`; in [0, 1],
         1 = off). Force closure says the contacts *could* hold the object; an underactuated
         hand does not choose its forces, and an unbalanced squeeze pushes the object away
-        before the last finger arrives or slides it out as the fingers close.
+        before the last finger arrives or slides it out as the fingers close. A constraint of
+        each evaluation; :func:`~contourgrasp.synthesis.search` prefers it, and plans without it
+        (with a note) when no pose meets it.
 
     Raises
     ------
