@@ -16,7 +16,7 @@ from ._derived import polygon
 from .cost import score
 from .inner import solve
 from .plan import PoseEvaluation
-from .safeguards import Safeguards, fingers_clear, grasp_epsilon, grasp_imbalance
+from .safeguards import Safeguards, fingers_clear, grade
 
 
 def evaluate_poses(
@@ -75,10 +75,7 @@ def evaluate_poses(
         clear = np.concatenate([fingers_clear(contour, hand, poses[rows], lam[rows], point[rows],
                                               clearance=safeguards.clearance)
                                 for rows in np.array_split(np.arange(len(poses)), -(-len(poses) // tol.POSE_BATCH))])
-    epsilon = np.full(len(poses), np.nan)
-    if safeguards.grades_quality:
-        epsilon = grasp_epsilon(model, point, t, touching, friction=safeguards.friction)
-    imbalance = grasp_imbalance(model, t, touching) if safeguards.balances else np.full(len(poses), np.nan)
+    epsilon, imbalance = grade(model, point, t, touching, safeguards)
     return score(hand, poses, touching, lam, t, point, curv, start_inside, d_min, clear, epsilon, safeguards,
                  imbalance=imbalance)
 

@@ -288,9 +288,10 @@ def _reevaluate_best(model, hand, screen: PoseEvaluation, n: int, curvature, d_m
     feasible = np.flatnonzero(screen.feasible)
     if safeguards.balances:  # screened on the polygon's contacts: the exact check below decides
         share = grasp_imbalance(model, screen.t[feasible], screen.touching[feasible])
-        if not (share <= safeguards.max_imbalance + tol.IMBALANCE_SCREEN).any():
+        near = share <= safeguards.max_imbalance + tol.IMBALANCE_SCREEN
+        if not near.any():
             raise NoFeasibleGrasp(_unbalanced(len(feasible), float(share.min(initial=1.0)), safeguards))
-        feasible = feasible[share <= safeguards.max_imbalance + tol.IMBALANCE_SCREEN]
+        feasible = feasible[near]
     order = feasible[np.argsort(screen.cost[feasible], kind="stable")]
     checked, descended, last = 0, 0, None
     while True:

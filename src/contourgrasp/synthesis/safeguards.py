@@ -163,7 +163,26 @@ def grasp_epsilon(model: EFD, grasp_point, t, touching, *, friction: float = 0.5
     touching : (p, f) bool
     friction : float
     """
+    return _epsilon(model, grasp_point, *_normals(model, t, touching), friction)
+
+
+def grade(model: EFD, grasp_point, t, touching, safeguards: Safeguards) -> tuple[np.ndarray, np.ndarray]:
+    """(p,) float twice: :func:`grasp_epsilon` and :func:`grasp_imbalance` where ``safeguards`` need them, else NaN.
+
+    The grasp points' normals are found once for both.
+    """
+    epsilon, imbalance = np.full(len(t), np.nan), np.full(len(t), np.nan)
+    if not (safeguards.grades_quality or safeguards.balances):
+        return epsilon, imbalance
     normals, valid = _normals(model, t, touching)
+    if safeguards.grades_quality:
+        epsilon = _epsilon(model, grasp_point, normals, valid, safeguards.friction)
+    if safeguards.balances:
+        imbalance = quality.imbalance(normals, valid)
+    return epsilon, imbalance
+
+
+def _epsilon(model: EFD, grasp_point, normals, valid, friction: float) -> np.ndarray:
     rho = cached(model, "rho", lambda: float(np.linalg.norm(polygon(model)[1] - model.locus, axis=1).max()))
     return quality.epsilon_many(grasp_point, normals, valid, mu=friction, centre=model.locus, rho=rho)
 
