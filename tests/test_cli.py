@@ -122,6 +122,9 @@ def test_bad_option_values_exit_2(capsys):
      "contourgrasp synth: error: argument --xy-step: must be a positive number, got 'abc' (see contourgrasp synth --help)"),
     (["synth", "--contour", "example:can", "--friction", "nan"],
      "contourgrasp synth: error: argument --friction: must be a number >= 0, got 'nan' (see contourgrasp synth --help)"),
+    (["synth", "--contour", "example:can", "--max-imbalance", "hands"],
+     "contourgrasp synth: error: argument --max-imbalance: must be a number >= 0 or 'hand', got 'hands' "
+     "(see contourgrasp synth --help)"),
     (["synth", "--contour", "example:can", "--harmonics", "many"],
      "contourgrasp synth: error: argument --harmonics: must be a positive integer or 'adaptive', got 'many' "
      "(see contourgrasp synth --help)"),

@@ -71,6 +71,16 @@ def _non_negative_float(text: str) -> float:
     return value
 
 
+def _imbalance(text: str) -> float | str:
+    """``--max-imbalance``: a share, or "hand" (the hand file's own)."""
+    if text == "hand":
+        return text
+    try:
+        return _non_negative_float(text)
+    except argparse.ArgumentTypeError:
+        raise argparse.ArgumentTypeError(f"must be a number >= 0 or 'hand', got {_shown(text)}") from None
+
+
 def _whole(text: str, minimum: int, wanted: str) -> int:
     try:
         value = int(text)
@@ -219,9 +229,9 @@ def _add_synthesis_options(parser) -> None:
     parser.add_argument("--require-closure", action=argparse.BooleanOptionalAction,
                         help="only poses whose grasp points are in force closure")
     parser.add_argument("--quality-gain", type=_non_negative_float, help="cost term -gain * epsilon")
-    parser.add_argument("--max-imbalance", type=_non_negative_float,
-                        help="refuse poses whose equal finger pushes leave more net force, share of their sum "
-                             "(0..1; 1: off)")
+    parser.add_argument("--max-imbalance", type=_imbalance, metavar="SHARE|hand",
+                        help="prefer poses whose equal finger pushes leave at most this net force, share of their "
+                             "sum (0..1; 1: off), or 'hand': the hand file's own")
     parser.add_argument("--top-k", type=_positive_int, default=10, help="ranked distinct poses to report")
     parser.add_argument("--refine", action=argparse.BooleanOptionalAction,
                         help="refine the best grid poses continuously (x, y, yaw) and report the gain")
@@ -284,6 +294,9 @@ def _add_hand_from_model_parser(sub) -> None:
                                                        "fingertip)")
     derive.add_argument("--approach", choices=APPROACHES,
                         help="the palm body's axis toward the object (default: the axis the fingers point along)")
+    derive.add_argument("--max-imbalance", type=_non_negative_float, metavar="SHARE",
+                        help="the hand's own squeeze balance, 0..1 (a planner's max_imbalance 'hand'; default: the "
+                             "bundled model's, else 0.25); closing in free air cannot measure it")
     derive.add_argument("--out", required=True, help="the hand TOML to write")
 
 
@@ -556,7 +569,7 @@ def _hand_from_model(args) -> int:
     from .sim.model_hand import derive_hand, fit_table
 
     derivation = derive_hand(args.model, fingertips=args.fingertips, actuators=args.actuators, palm=args.palm,
-                             approach=args.approach)
+                             approach=args.approach, max_imbalance=args.max_imbalance)
     print("\n".join(fit_table(derivation)))
     comment = "\n".join([f"Derived by `contourgrasp hand-from-model` from {Path(args.model).name}: fit errors (mm)",
                           *(f"  {fit.name}: {fit.kind} {1000 * fit.error:.2f}" for fit in derivation.fits),

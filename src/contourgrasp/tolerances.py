@@ -385,6 +385,11 @@ MIN_SECTION_CELLS = 50
 #: Against no screen at all, ycb-train's 84 bench trials (seeds 0-3) and ycb's 410 were the same, trial for trial.
 IMBALANCE_SCREEN = 0.05
 
+#: A hand's own max_imbalance (Hand.max_imbalance, the planner option's "hand") when its file states none. Chosen
+#: on the five-finger hand's ycb-train and thesis's-five trials (benchmarks/balance_sweep.md); on the three-finger
+#: preset's it ties with 1/3.
+HAND_MAX_IMBALANCE = 0.25
+
 #: The small-object rule (pipeline.plan_frame(small_objects=True)): the fewest touching fingers it plans with (at
 #: least the hand's required ones): the thumb against one finger. Chosen on ycb-train (README, "3-D hand"): with
 #: three, the strawberry still had no plan.

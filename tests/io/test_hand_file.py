@@ -90,7 +90,8 @@ def test_presets_have_the_table_values():
 def test_hand_to_toml_round_trips(name):
     hand = load_hand(name)
     again = parse_hand(hand_to_toml(hand, comment="a\nb"))
-    assert (again.name, again.min_touching, again.miss_penalty) == (hand.name, hand.min_touching, hand.miss_penalty)
+    assert (again.name, again.min_touching, again.miss_penalty, again.max_imbalance) == (
+        hand.name, hand.min_touching, hand.miss_penalty, hand.max_imbalance)
     for f, g in zip(hand.fingers, again.fingers, strict=True):
         assert (g.name, g.start, g.travel, g.virtual_start, g.alpha, g.beta, g.required) == (
             f.name, f.start, f.travel, f.virtual_start, f.alpha, f.beta, f.required)

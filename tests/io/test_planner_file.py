@@ -49,6 +49,8 @@ def test_a_file_round_trips_its_options(tmp_path):
     ('name = "x"\ngrasp_height = "high"', "grasp_height"),
     ('name = "x"\ngrasp_height = -0.1', "grasp_height: Value error, a grasp height must be in"),
     ('name = "x"\nsmall_objects = "yes"', "small_objects"),
+    ('name = "x"\nmax_imbalance = "hands"', "max_imbalance"),
+    ('name = "x"\nmax_imbalance = 1.5', "max_imbalance"),
 ])
 def test_bad_files_name_the_field(text, field):
     with pytest.raises(PlannerFileError, match=f"mine.toml: {field}"):

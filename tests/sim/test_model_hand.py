@@ -85,6 +85,16 @@ def test_bundled_models_derive_hands_within_the_tolerance(name, fingers):
         derived.hand.starts - derived.hand.starts.mean(axis=0), axis=1).mean()  # closing brings the tips together
 
 
+def test_a_derived_hand_carries_the_models_squeeze_balance(sliders):
+    # closing in free air cannot measure it: the bundled Jaco's is chosen on the bench, a file's is the default
+    assert derive_hand("jaco-three-finger").hand.max_imbalance == 1.0
+    assert derive_hand("inspire").hand.max_imbalance == tol.HAND_MAX_IMBALANCE
+    mine = derive_hand(sliders, fingertips=["left_tip", "right_tip"], max_imbalance=0.5).hand
+    assert mine.max_imbalance == 0.5
+    with pytest.raises(HandError, match="max_imbalance must be at most 1"):
+        derive_hand(sliders, fingertips=["left_tip", "right_tip"], max_imbalance=2.0)
+
+
 def test_bad_models_are_refused_naming_what(sliders, tmp_path):
     with pytest.raises(HandFileError, match="no site or body named 'nose'"):
         derive_hand(sliders, fingertips=["left_tip", "nose"])

@@ -116,6 +116,20 @@ def test_a_balanced_squeeze_is_planned_when_one_exists():
     assert balanced.notes == ()
 
 
+def test_the_hands_own_balance_is_the_one_planned_with():
+    contour = cg.example_contour("case")
+    hand = dataclasses.replace(cg.load_hand("five-finger-linear"), min_touching=2)
+    assert hand.max_imbalance == 0.25  # tolerances.HAND_MAX_IMBALANCE: the file states none
+    for own in (0.25, 1.0):
+        mine = dataclasses.replace(hand, max_imbalance=own)
+        plan = cg.synthesize(contour, mine, require_closure=True, max_imbalance="hand", **FAST)
+        same = cg.synthesize(contour, mine, require_closure=True, max_imbalance=own, **FAST)
+        assert plan.safeguards.max_imbalance == own
+        np.testing.assert_array_equal(plan.pose, same.pose)
+    with pytest.raises(InputError, match="max_imbalance must be one of 'hand'"):
+        cg.synthesize(contour, hand, max_imbalance="hands", **FAST)
+
+
 def test_without_a_balanced_pose_the_plan_is_the_unbalanced_best_and_says_so():
     contour, hand = cg.example_contour("case"), cg.load_hand("five-finger-linear")  # four fingers must touch
     free = cg.synthesize(contour, hand, require_closure=True, **FAST)

@@ -8,6 +8,7 @@ and plans as one.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -52,6 +53,13 @@ class Hand:
         A pose is feasible only when at least this many fingers touch the object.
     miss_penalty : float
         Cost added per finger that closes on air (the ``miss`` part of the cost).
+    max_imbalance : float
+        The squeeze's balance this hand is planned with when the planner asks for the hand's own
+        (``max_imbalance="hand"``, as ``default`` does; :class:`~contourgrasp.synthesis.Safeguards`):
+        in [0, 1], 1 off. How unbalanced a squeeze a hand can hold depends on how its fingers are
+        driven, which no trajectory shows: a tendon hand is pushed off an unbalanced squeeze, fingers
+        holding their own positions stop the object against the others. Default
+        ``tolerances.HAND_MAX_IMBALANCE``.
     description : str
     chains : tuple of FingerChain, optional
         The fingers' bodies, one per finger in the order of ``fingers``; None (the default) for a
@@ -62,7 +70,8 @@ class Hand:
     ------
     HandError
         No fingers or more than ``tolerances.MAX_FINGERS``, a finger that is not a :class:`Finger`, names not unique, ``min_touching``
-        not in 1..number of fingers, or ``miss_penalty`` not in [0, ``tolerances.MAX_GAIN``];
+        not in 1..number of fingers, ``miss_penalty`` not in [0, ``tolerances.MAX_GAIN``] or ``max_imbalance``
+        not in [0, 1];
         chains without a palm or the reverse, not one chain per finger, or a chain that does not
         realise its finger's trajectory (:func:`check_chain`, naming the finger).
     """
@@ -71,6 +80,7 @@ class Hand:
     fingers: tuple[Finger, ...]
     min_touching: int
     miss_penalty: float = 250.0
+    max_imbalance: float = tol.HAND_MAX_IMBALANCE
     description: str = field(default="", compare=False)
     chains: tuple[FingerChain, ...] | None = None
     palm: Palm | None = None
@@ -89,6 +99,8 @@ class Hand:
                 1 <= self.min_touching <= n):
             raise HandError(f"hand {self.name!r}: min_touching must be in 1..{n}, got {self.min_touching!r}")
         check.bounded(f"hand {self.name!r}: miss_penalty", self.miss_penalty, tol.MAX_GAIN, error=HandError)
+        object.__setattr__(self, "max_imbalance", float(
+            check.bounded(f"hand {self.name!r}: max_imbalance", self.max_imbalance, 1.0, "", error=HandError)))
         if len({f.name for f in self.fingers}) != n:
             raise HandError(f"hand {self.name!r}: finger names must be unique")
         self._check_body()
@@ -106,7 +118,7 @@ class Hand:
         if len(self.chains) != len(self.fingers):
             raise HandError(f"hand {self.name!r}: {len(self.chains)} chains for {len(self.fingers)} fingers")
         for finger, chain in zip(self.fingers, self.chains, strict=True):
-            check_chain(finger, chain)
+            _check_chain_once(finger, chain)
 
     @property
     def is_3d(self) -> bool:
@@ -185,3 +197,9 @@ class HandSegments:
     @property
     def length(self) -> np.ndarray:
         return np.linalg.norm(self.end - self.start, axis=1)
+
+
+@functools.lru_cache(maxsize=64)
+def _check_chain_once(finger: Finger, chain: FingerChain) -> None:
+    """:func:`check_chain`, remembered: the search copies its hand per attempt (``min_touching``), 1 ms each."""
+    check_chain(finger, chain)

@@ -8,6 +8,9 @@ Schema (all lengths in meters, angles in radians)::
     miss_penalty = 250.0             # optional, >= 0, cost per finger closing on air;
                                      # default 10 x the largest alpha (about one finger's
                                      # swing of paper-curvature cost, |C| <~ 5 m)
+    max_imbalance = 0.25             # optional, 0..1: the squeeze's balance the hand is planned
+                                     # with by a planner asking for the hand's (default's
+                                     # max_imbalance = "hand"); default 0.25; 1: off
 
     [[fingers]]                      # one table per finger, at least one
     name = "thumb"
@@ -139,6 +142,7 @@ class _HandSchema(_Strict):
     description: str = ""
     min_touching: int = Field(ge=1)
     miss_penalty: Gain | None = None
+    max_imbalance: Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] = tol.HAND_MAX_IMBALANCE
     fingers: list[_FingerSchema] = Field(min_length=1, max_length=tol.MAX_FINGERS)
     palm: _PalmSchema | None = None
 
@@ -199,6 +203,7 @@ def parse_hand(text: str, *, source: str = "<string>") -> Hand:
             fingers=fingers,
             min_touching=schema.min_touching,
             miss_penalty=_miss_penalty(schema),
+            max_imbalance=schema.max_imbalance,
             description=schema.description,
             chains=chains,
             palm=palm,
@@ -273,7 +278,8 @@ def hand_to_toml(hand: Hand, *, comment: str = "") -> str:
     """The text of a hand file that loads back as ``hand``, ``comment`` as its header."""
     lines = [f"# {line}".rstrip() for line in comment.splitlines()]
     lines += [f"name = {_string(hand.name)}", f"description = {_string(hand.description)}",
-              f"min_touching = {hand.min_touching}", f"miss_penalty = {_float(hand.miss_penalty)}"]
+              f"min_touching = {hand.min_touching}", f"miss_penalty = {_float(hand.miss_penalty)}",
+              f"max_imbalance = {_float(hand.max_imbalance)}"]
     for f in hand.fingers:
         lines += ["", "[[fingers]]", f"name = {_string(f.name)}", f"start = {_floats(f.start)}"]
         if isinstance(f.trajectory, Ray):

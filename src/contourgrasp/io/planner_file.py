@@ -24,7 +24,8 @@ which is the thesis's setting)::
     friction = 0.5
     require_closure = false
     quality_gain = 0.0
-    max_imbalance = 1.0          # refuse poses whose equal finger pushes leave more net force (1: off)
+    max_imbalance = 1.0          # prefer poses whose equal finger pushes leave at most this share of net force
+                                 # (1: off), or "hand": the hand file's own (Hand.max_imbalance)
     descent = false              # the open 3-D hand's descent onto the height map (synthesis.Descent)
     grasp_height = "clearance"   # or "auto", or a height in m (synthesis.grasp_height)
     slice_contour = false        # plan on the cross-section at the grasp height (perception.cross_section)
@@ -80,7 +81,7 @@ class _PlannerSchema(BaseModel):
     friction: Annotated[float, Field(ge=0, le=tol.MAX_FRICTION, allow_inf_nan=False)] | None = None
     require_closure: bool | None = None
     quality_gain: NonNegative | None = None
-    max_imbalance: Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] | None = None
+    max_imbalance: Literal["hand"] | Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] | None = None
     descent: bool | None = None
     slice_contour: bool | None = None
     closing_sweep: bool | None = None

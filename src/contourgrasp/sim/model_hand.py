@@ -96,6 +96,9 @@ class ModelSpec:
     approach : str or None
         The palm axis (``"x"``, ``"-x"``, ..., ``"-z"``) that is the approach (the hand frame's z);
         None: the axis the fingers point along (module docstring).
+    max_imbalance : float
+        The derived hand's :attr:`Hand.max_imbalance`: closing the model in free air does not show
+        how unbalanced a squeeze its drive holds, so it is chosen on the bench, not derived.
     """
 
     path: str
@@ -105,6 +108,7 @@ class ModelSpec:
     names: tuple[str, ...] | None = None
     hold: tuple[tuple[str, float], ...] = ()
     approach: str | None = None
+    max_imbalance: float = tol.HAND_MAX_IMBALANCE
 
 
 def _bundled(folder: str, xml: str, fingers, **options) -> ModelSpec:
@@ -115,7 +119,9 @@ def _bundled(folder: str, xml: str, fingers, **options) -> ModelSpec:
 _INSPIRE_FINGERS = ("thumb", "index", "middle", "ring", "pinky")
 
 #: The hand models shipped with the package (from robosuite 1.5.2, MIT; data/models/README.md). The
-#: Inspire hand's thumb rotation is its own motor: held opposed (the high end), not part of the synergy.
+#: Inspire hand's thumb rotation is its own motor: held opposed (the high end), not part of the synergy. The Jaco's
+#: fingers each hold their own position: its squeeze's balance is off (max_imbalance 1), chosen on its ycb-train
+#: and thesis's-five trials (benchmarks/balance_sweep.md).
 MODELS = {
     "inspire": _bundled(
         "inspire", "inspire_right_hand.xml", _INSPIRE_FINGERS, palm="r_palm",
@@ -124,11 +130,12 @@ MODELS = {
         + ("thumb_proximal_2_drive", "thumb_middle_drive", "thumb_distal_drive"),
         hold=(("thumb_proximal_1_drive", 1.0),)),
     "jaco-three-finger": _bundled("jaco_three_finger", "jaco_three_finger_gripper.xml", ("thumb", "index", "pinky"),
-                                  palm="right_gripper", names=("thumb", "index", "pinky")),
+                                  palm="right_gripper", names=("thumb", "index", "pinky"), max_imbalance=1.0),
 }
 
 
-def model_spec(model, *, fingertips=None, actuators=None, palm=None, approach=None) -> ModelSpec:
+def model_spec(model, *, fingertips=None, actuators=None, palm=None, approach=None,
+               max_imbalance=None) -> ModelSpec:
     """A :class:`ModelSpec` from a bundled model's name (:data:`MODELS`) or an MJCF path; options override.
 
     Raises
@@ -151,6 +158,8 @@ def model_spec(model, *, fingertips=None, actuators=None, palm=None, approach=No
         spec = replace(spec, actuators=tuple(actuators))
     if approach is not None:
         spec = replace(spec, approach=approach)
+    if max_imbalance is not None:
+        spec = replace(spec, max_imbalance=max_imbalance)
     return replace(spec, palm=palm) if palm is not None else spec
 
 
@@ -251,15 +260,15 @@ def load_model(path) -> mujoco.MjModel:
         raise HandFileError(f"{path}: cannot load the MuJoCo model ({reason})") from None
 
 
-def derive_hand(model, *, fingertips=None, actuators=None, palm=None, approach=None, name: str | None = None,
-                close_time: float = 1.0, hold_time: float = 0.5) -> Derivation:
+def derive_hand(model, *, fingertips=None, actuators=None, palm=None, approach=None, max_imbalance=None,
+                name: str | None = None, close_time: float = 1.0, hold_time: float = 0.5) -> Derivation:
     """Close a MuJoCo hand model with one synergy and fit its hand file (module docstring).
 
     Parameters
     ----------
     model : str, Path or ModelSpec
         A bundled model's name (:data:`MODELS`) or an MJCF file.
-    fingertips, actuators, palm, approach
+    fingertips, actuators, palm, approach, max_imbalance
         Override the :class:`ModelSpec`'s (fingertips are required for a file).
     name : str, optional
         The hand's name; default the model file's stem.
@@ -280,7 +289,8 @@ def derive_hand(model, *, fingertips=None, actuators=None, palm=None, approach=N
     SimulationError
         The model is unstable while closing.
     """
-    spec = model_spec(model, fingertips=fingertips, actuators=actuators, palm=palm, approach=approach)
+    spec = model_spec(model, fingertips=fingertips, actuators=actuators, palm=palm, approach=approach,
+                      max_imbalance=max_imbalance)
     closed = close_model(spec, close_time=close_time, hold_time=hold_time)
     fingers, fits, ends = [], [], []
     for i, finger_name in enumerate(closed.names):
@@ -291,7 +301,7 @@ def derive_hand(model, *, fingertips=None, actuators=None, palm=None, approach=N
         fits.append(fit)
     default_name = str(model) if isinstance(model, str) and model in MODELS else Path(spec.path).stem
     hand = Hand(name=name or default_name, fingers=tuple(fingers), min_touching=_min_touching(len(fingers)),
-                miss_penalty=MISS_PENALTY, description=f"derived from {Path(spec.path).name} by hand-from-model")
+                miss_penalty=MISS_PENALTY, max_imbalance=spec.max_imbalance, description=f"derived from {Path(spec.path).name} by hand-from-model")
     hand = _with_virtual_starts(hand, closed)
     hand, notes = _with_chains(hand, closed, ends)
     return Derivation(hand=hand, fits=tuple(fits), notes=notes, mount=closed.mount)

@@ -61,7 +61,7 @@ def search(
     friction: float = 0.5,
     require_closure: bool = False,
     quality_gain: float = 0.0,
-    max_imbalance: float = 1.0,
+    max_imbalance: float | Literal["hand"] = 1.0,
     small_objects: bool = False,
     descent: Descent | None = None,
 ) -> GraspPlan:
@@ -96,7 +96,8 @@ def search(
     finger_thickness, clearance, friction, require_closure, quality_gain, max_imbalance
         The :class:`~contourgrasp.synthesis.Safeguards` (all off: the thesis's problem).
         ``friction`` is also the mu of the plan's reported ``quality``.
-    max_imbalance : float
+    max_imbalance : float or "hand"
+        ``"hand"``: the hand's own, :attr:`Hand.max_imbalance` (what its fingers' drive can hold).
         A balanced squeeze is preferred, not required: when no pose meets it (with the small-object
         rule's fewer fingers too), the search is repeated without it, and the plan's notes say so.
     small_objects : bool
@@ -146,6 +147,9 @@ def search(
             raise PlannerError(f"descent must be a contourgrasp.synthesis.Descent, got {type(descent).__name__}")
         body_names(hand)  # refuses a hand without 3-D geometry
     grid = SearchGrid(xy_step=xy_step, yaw_step=yaw_step, d_max=d_max, d_min=d_min)
+    if isinstance(max_imbalance, str):
+        check.choice("max_imbalance", max_imbalance, ("hand",), error=PlannerError)
+        max_imbalance = hand.max_imbalance
     safeguards = Safeguards(finger_thickness=check.flag("finger_thickness", finger_thickness, error=PlannerError),
                             clearance=clearance, friction=friction,
                             require_closure=check.flag("require_closure", require_closure, error=PlannerError),
