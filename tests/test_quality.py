@@ -471,6 +471,11 @@ def test_imbalance_is_a_share_invariant_under_rotation(turn, angles):
     assert q.imbalance(turned)[0] == pytest.approx(share, abs=1e-9)
 
 
+def test_imbalance_names_the_normals_of_a_bad_batch():
+    with pytest.raises(QualityError, match=r"^normals must be a \(p, n, 2\) array, got shape \(3, 2\)$"):
+        q.imbalance(np.ones((3, 2)))
+
+
 def test_imbalance_refuses_a_zero_normal():
     with pytest.raises(QualityError, match="normals"):
         q.imbalance(np.array([[[1.0, 0.0], [0.0, 0.0]]]))
