@@ -361,6 +361,8 @@ def _perceive(rgb, depth, intrinsics, *, segment, mask, depth_mode, footprint, f
             options["plane"] = plane  # the same fit segmentation would make
         if target is not None and (chosen or target is not next(c for c in candidates if c.in_view)):
             options["target"] = target.mask  # else segmentation's own pick, the largest wholly visible region
+        if target_px is not None:
+            options["target_px"] = target_px  # which of the target's footprints, where touching neighbours share it
         seg = perception.segment(rgb, d, intrinsics, method=segment, colour_offset_px=colour_offset_px,
                                  depth_options=options)
     if mask is not None or seg.method == "rgb":

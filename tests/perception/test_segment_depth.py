@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 
+import numpy as np
 import pytest
+from scipy import ndimage
 
+from contourgrasp.errors import SegmentationError
 from contourgrasp.perception import segment_depth
 from perception_scenes import CAMERA, render, render_footprint, iou
 
@@ -34,8 +37,6 @@ def test_footprint_is_where_the_object_stands(tilt_deg):
 
 @pytest.mark.parametrize("footprint", [False, True])
 def test_a_hole_that_sees_the_table_is_object_free_and_a_hole_of_missing_readings_is_filled(footprint):
-    import numpy as np
-
     table = np.full((CAMERA.height, CAMERA.width), 0.7)
     ring, block = table.copy(), table.copy()
     ring[200:280, 280:360] = 0.68  # a 2 cm thick ring whose 40 x 40 px eye sees the table
@@ -49,3 +50,36 @@ def test_a_hole_that_sees_the_table_is_object_free_and_a_hole_of_missing_reading
     assert eye.area_px == eye.mask.sum()
     if not footprint:
         assert eye.area_px == 6400 - 1600 and unseen.area_px == 6400
+
+
+def _tall_box_over_a_flat_one():
+    """A 15 cm box whose side, seen 25 deg tilted, covers a flat box 6 cm behind it: one region, two footprints."""
+    tall, _, tall_seen, _ = render(kind="box", tilt_deg=25.0, radius=0.02, height=0.15)
+    flat, _, flat_seen, _ = render(kind="box", tilt_deg=25.0, radius=0.03, height=0.02, centre=(0.0, -0.11))
+    depth = np.minimum(tall, flat)
+    feet = (render_footprint(kind="box", tilt_deg=25.0, radius=0.02),
+            render_footprint(kind="box", tilt_deg=25.0, radius=0.03, centre=(0.0, -0.11)))
+    return depth, (tall_seen & (tall <= flat), flat_seen & (flat < tall)), feet
+
+
+def _innermost(mask):
+    v, u = np.unravel_index(np.argmax(ndimage.distance_transform_edt(mask)), mask.shape)
+    return int(u), int(v)
+
+
+def test_the_clicked_object_is_taken_where_touching_neighbours_share_a_region():
+    depth, seen, (tall, flat) = _tall_box_over_a_flat_one()
+    assert ndimage.label(seen[0] | seen[1])[1] == 1  # the view joins them
+    with pytest.warns(UserWarning, match="2 regions in the object's footprint"):
+        largest = segment_depth(depth, CAMERA, footprint=True).mask
+    assert iou(largest, flat) > 0.6 and iou(largest, tall) == 0  # without a click: the largest footprint
+    clicked_tall = segment_depth(depth, CAMERA, footprint=True, target_px=_innermost(seen[0])).mask
+    assert iou(clicked_tall, tall) > 0.9
+    clicked_flat = segment_depth(depth, CAMERA, footprint=True, target_px=_innermost(seen[1])).mask
+    assert iou(clicked_flat, flat) > 0.6 and iou(clicked_flat, tall) == 0
+
+
+def test_a_click_outside_the_image_is_refused():
+    depth, _, _ = _tall_box_over_a_flat_one()
+    with pytest.raises(SegmentationError, match=r"pixel \(9999, 5\) is outside"):
+        segment_depth(depth, CAMERA, footprint=True, target_px=(9999, 5))

@@ -5,6 +5,9 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
+from .. import validation
+from ..errors import PerceptionError, SegmentationError
+
 
 def connected_to(region, mask):
     """(H, W) bool: the 8-connected parts of ``region`` that hold a pixel of ``mask`` (a subset of it)."""
@@ -62,3 +65,11 @@ def in_image(uv, shape):
     u[seen], v[seen] = np.rint(uv[seen]).astype(int).T
     seen &= (u >= 0) & (u < shape[1]) & (v >= 0) & (v < shape[0])
     return seen, u, v
+
+
+def check_pixel(target_px, shape=None) -> tuple[int, int]:
+    """``target_px`` as two integers (u, v), inside an image of ``shape`` (H, W) when given."""
+    u, v = validation.integers("target_px", target_px, "u, v", error=PerceptionError)
+    if shape is not None and not (0 <= u < shape[1] and 0 <= v < shape[0]):
+        raise SegmentationError("no-object", f"pixel ({u}, {v}) is outside the {shape[1]}x{shape[0]} image")
+    return u, v

@@ -32,6 +32,7 @@ from scipy import ndimage
 from .. import validation
 from ..errors import PerceptionError, SegmentationError
 from ..tolerances import CANDIDATE_DEPTH_STEP, ENCLOSED_FRACTION, MIN_AREA_PX, MIN_HEIGHT, SENSOR_RANGE, SIMILAR_SIZE
+from ._pixels import check_pixel
 from .camera import Intrinsics, as_depth, check_intrinsics, valid_depth
 from .region import mask_contour, touching_regions
 from .segment_depth import raised_pixels
@@ -355,14 +356,6 @@ def hand_opening(hand) -> float:
     """The widest object a hand spans, m: the largest distance between two of its fingers' start points."""
     starts = np.asarray(hand.starts, dtype=float)
     return float(np.max(np.linalg.norm(starts[:, None] - starts[None], axis=-1)))
-
-
-def check_pixel(target_px, shape=None) -> tuple[int, int]:
-    """``target_px`` as two integers (u, v), inside an image of ``shape`` (H, W) when given."""
-    u, v = validation.integers("target_px", target_px, "u, v", error=PerceptionError)
-    if shape is not None and not (0 <= u < shape[1] and 0 <= v < shape[0]):
-        raise SegmentationError("no-object", f"pixel ({u}, {v}) is outside the {shape[1]}x{shape[0]} image")
-    return u, v
 
 
 def check_roi(roi, shape=None) -> tuple[int, int, int, int]:

@@ -17,7 +17,7 @@ from .. import validation
 from ..errors import PerceptionError
 from ..tolerances import (MAX_HOLE_PX, MIN_AREA_PX, MIN_HEIGHT, MIN_TABLE_HOLE_PX, PLANE_THRESHOLD, SENSOR_RANGE,
                           TILT_PLANE_THRESHOLD)
-from ._pixels import disc, grown_box, in_image
+from ._pixels import check_pixel, disc, grown_box, in_image
 from .camera import Intrinsics, as_depth, check_intrinsics, fill_depth_holes, valid_depth
 from .region import Segmentation, make_segmentation, pick_object
 from .table import Plane, fit_table_plane, footprint_pixels, heights
@@ -36,6 +36,7 @@ def segment_depth(
     footprint: bool | None = None,
     seed: int = 0,
     target=None,
+    target_px=None,
 ) -> Segmentation:
     """The region standing above the table, or its footprint on the table.
 
@@ -89,6 +90,11 @@ def segment_depth(
         overlaps this mask most (the ``mask`` of a
         :class:`~contourgrasp.perception.candidates.Candidate` chosen by
         :func:`~contourgrasp.perception.candidates.choose_target`).
+    target_px : (int, int), optional
+        The pixel (u, v) a user clicked on the object. A candidate may hold neighbours that touch
+        in the view (candidates are split only where one encloses another); their footprints then
+        fall apart, and the region taken is the one nearest where the clicked point stands on the
+        table, not the largest (:func:`with_footprint`).
 
     Raises
     ------
@@ -98,7 +104,7 @@ def segment_depth(
     seen, d = seen_above_table(depth, intrinsics, min_height=min_height, plane=plane, fill_holes=fill_holes,
                                 max_hole_px=max_hole_px, min_area_px=min_area_px, depth_range=depth_range, seed=seed,
                                 target=target)
-    return with_footprint(seen, d, intrinsics, footprint, min_area_px)
+    return with_footprint(seen, d, intrinsics, footprint, min_area_px, target_px=target_px)
 
 
 def seen_above_table(depth, intrinsics, *, min_height, plane, fill_holes, max_hole_px, min_area_px, depth_range, seed,
@@ -159,9 +165,14 @@ def raised_pixels(depth, intrinsics: Intrinsics, plane: Plane, *, min_height: fl
     return above, _border_connected(~valid)
 
 
-def with_footprint(seg, depth, intrinsics, footprint, min_area_px) -> Segmentation:
+def with_footprint(seg, depth, intrinsics, footprint, min_area_px, *, target_px=None) -> Segmentation:
     """``seg`` moved onto the table (:func:`object_footprint`) when ``footprint``, or when None and the camera is
-    tilted; either way with the holes through which the table is seen opened again (:func:`open_table_holes`)."""
+    tilted; either way with the holes through which the table is seen opened again (:func:`open_table_holes`).
+
+    Where the footprint falls into several regions, the largest is taken, or with ``target_px`` (u, v) the one
+    nearest the clicked point's own footprint (:func:`clicked_region`)."""
+    if target_px is not None:
+        target_px = check_pixel(target_px, seg.mask.shape)
     if footprint is None:
         footprint = seg.plane.tilt > TILT_PLANE_THRESHOLD
     elif not isinstance(footprint, (bool, np.bool_)):
@@ -169,10 +180,33 @@ def with_footprint(seg, depth, intrinsics, footprint, min_area_px) -> Segmentati
     if not footprint:
         return replace(seg, **_opened(seg.mask, depth, intrinsics, seg.plane))
     moved = object_footprint(seg.mask, depth, intrinsics, seg.plane)
-    mask, notes = pick_object(moved, np.zeros_like(moved), min_area_px, "in the object's footprint on the table")
+    target = None if target_px is None else clicked_region(moved, target_px, depth, intrinsics, seg.plane, min_area_px)
+    mask, notes = pick_object(moved, np.zeros_like(moved), min_area_px, "in the object's footprint on the table",
+                              target=target)
     result = make_segmentation(seg.method, mask, notes, plane=seg.plane, filled_px=seg.filled_px, on_table=True,
                            colour_offset_px=seg.colour_offset_px)
     return replace(result, warnings=(*seg.warnings, *result.warnings), **_opened(mask, depth, intrinsics, seg.plane))
+
+
+def clicked_region(footprint, target_px, depth, intrinsics: Intrinsics, plane: Plane, min_area_px: int):
+    """(H, W) bool or None: the region of ``footprint`` (8-connected, at least ``min_area_px``) nearest the pixel
+    where the point seen at ``target_px`` (u, v) stands on the table; None when that point has no valid depth,
+    stands outside the image, or no region is large enough (then the largest region is taken).
+
+    A candidate holding two objects that touch in a tilted view (a bottle standing over scissors) is
+    one region seen, two footprints: the click says which object is meant.
+    """
+    u, v = target_px
+    if not valid_depth(depth[v:v + 1, u:u + 1])[0, 0]:
+        return None
+    inside, fu, fv = in_image(footprint_pixels(depth, intrinsics, plane, np.array([v]), np.array([u])), footprint.shape)
+    _, labels, stats, _ = cv2.connectedComponentsWithStats(footprint.astype(np.uint8), connectivity=8)
+    large = np.flatnonzero(stats[1:, cv2.CC_STAT_AREA] >= min_area_px) + 1
+    if not inside[0] or len(large) < 2:
+        return None
+    rows, cols = np.nonzero(np.isin(labels, large))
+    nearest = np.argmin((rows - fv[0]) ** 2 + (cols - fu[0]) ** 2)
+    return labels == labels[rows[nearest], cols[nearest]]
 
 
 def _opened(mask, depth, intrinsics, plane) -> dict:

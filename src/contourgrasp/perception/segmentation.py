@@ -121,7 +121,7 @@ def segment(
     if method == "depth" or rgb is None:
         return segment_depth(depth, intrinsics, **depth_options)
     seen_options = {**validation.keyword_defaults(segment_depth), **depth_options}
-    footprint = seen_options.pop("footprint")
+    footprint, target_px = seen_options.pop("footprint"), seen_options.pop("target_px")
     try:
         seen, d = seen_above_table(depth, intrinsics, **seen_options)
     except SegmentationError as err:
@@ -134,7 +134,7 @@ def segment(
         grown = add_flat_parts(register_colour(rgb, offset), seen, d, intrinsics,
                                **{"min_height": seen_options["min_height"], **colour_options})
         return with_footprint(replace(grown, colour_offset_px=offset), d, intrinsics, footprint,
-                               seen_options["min_area_px"])
+                               seen_options["min_area_px"], target_px=target_px)
     result = segment_rgb(rgb, **rgb_options)
     warnings.warn(note, PerceptionWarning, stacklevel=2)
     return replace(result, warnings=(note, *result.warnings))
