@@ -428,7 +428,7 @@ def _check_contacts(points, normals) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _check_contact_batch(points, normals, valid) -> tuple[np.ndarray | None, np.ndarray, np.ndarray]:
-    """Points (or None when not given), unit normals (g, k, 2) with invalid entries neutralised, the valid mask (g, k)."""
+    """Points (None if not given), unit normals (g, k, 2) with invalid entries neutralised, the valid mask (g, k)."""
     n, p = _as_float(normals, "normals"), None
     if points is None:
         if n.ndim != 3 or n.shape[2] != 2:

@@ -301,7 +301,8 @@ def derive_hand(model, *, fingertips=None, actuators=None, palm=None, approach=N
         fits.append(fit)
     default_name = str(model) if isinstance(model, str) and model in MODELS else Path(spec.path).stem
     hand = Hand(name=name or default_name, fingers=tuple(fingers), min_touching=_min_touching(len(fingers)),
-                miss_penalty=MISS_PENALTY, max_imbalance=spec.max_imbalance, description=f"derived from {Path(spec.path).name} by hand-from-model")
+                miss_penalty=MISS_PENALTY, max_imbalance=spec.max_imbalance,
+                description=f"derived from {Path(spec.path).name} by hand-from-model")
     hand = _with_virtual_starts(hand, closed)
     hand, notes = _with_chains(hand, closed, ends)
     return Derivation(hand=hand, fits=tuple(fits), notes=notes, mount=closed.mount)
