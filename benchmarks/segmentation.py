@@ -37,7 +37,8 @@ as in ``contourgrasp bench --scene``. Per kind and split: the target's IoU
 when perception is given the target's pixel (:func:`contourgrasp.sim.target_pixel`,
 as the bench gives it) against the exact footprint (camera tilted more than
 2 deg) or the exact region seen (:func:`contourgrasp.sim.object_truth`, what
-``auto`` aims at), a refused frame scoring 0; and the candidates
+``auto`` aims at), a refused frame scoring 0, and how many targets score below
+``MATCH_IOU`` (another object planned on, or a merged one); and the candidates
 (:func:`contourgrasp.perception.find_candidates` on the fitted table plane)
 against the objects present (:func:`contourgrasp.sim.truth_labels`, those
 seen by at least ``MIN_AREA_PX`` pixels): how many were found, and how many
@@ -257,13 +258,14 @@ def print_rendered_scenes(seeds) -> None:
     rows = rendered_scenes(seeds)
     print(f"\nScenes of several objects ({seeds} per kind and split, the bench's camera tilted 0-25 deg, its depth "
           f"noise): the target given by its pixel, candidates against the objects present\n")
-    print("| scene | split | target IoU, mean (worst) | refused | objects present | candidates found | "
-          f"objects found (IoU >= {MATCH_IOU}) | target IoU in grey, mean (worst) |")
-    print("|---|---|---:|---:|---:|---:|---:|---:|")
+    print(f"| scene | split | target IoU, mean (worst) | targets below {MATCH_IOU} | refused | objects present | "
+          f"candidates found | objects found (IoU >= {MATCH_IOU}) | target IoU in grey, mean (worst) |")
+    print("|---|---|---:|---:|---:|---:|---:|---:|---:|")
     for (kind, split), scores in rows.items():
         a = np.array(scores)
-        print(f"| {kind} | {split} | {a[:, 0].mean():.3f} ({a[:, 0].min():.3f}) | {int(a[:, 1].sum())} | "
-              f"{int(a[:, 2].sum())} | {int(a[:, 3].sum())} | {int(a[:, 4].sum())} | {a[:, 5].mean():.3f} ({a[:, 5].min():.3f}) |")
+        print(f"| {kind} | {split} | {a[:, 0].mean():.3f} ({a[:, 0].min():.3f}) | {int((a[:, 0] < MATCH_IOU).sum())} | "
+              f"{int(a[:, 1].sum())} | {int(a[:, 2].sum())} | {int(a[:, 3].sum())} | {int(a[:, 4].sum())} | "
+              f"{a[:, 5].mean():.3f} ({a[:, 5].min():.3f}) |")
 
 
 def main(argv=None) -> int:
