@@ -234,3 +234,12 @@ def test_the_small_object_rule_plans_fewer_touching_fingers_and_says_why_when_it
     assert plan.hand.min_touching == 2 and sum(not f.missed for f in plan.fingers) == 2
     with pytest.raises(cg.NoFeasibleGrasp, match="with the small-object rule, down to 2 touching fingers: no pose"):
         cg.synthesize(disc / 7, "five-finger-linear", small_objects=True, **grid)
+
+
+def test_an_attempts_reason_is_worked_out_once_and_only_when_asked():
+    from contourgrasp.synthesis.outer import _Unexplained
+
+    calls = []
+    failure = _Unexplained(lambda: calls.append(1) or "blocked")
+    assert calls == [] and isinstance(failure, NoFeasibleGrasp)
+    assert str(failure) == failure.reason == "blocked" and calls == [1]

@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import replace
+from functools import partial
 from typing import Literal
 
 import numpy as np
@@ -177,7 +178,7 @@ def search(
                                   grid, guards, descent, curvature=curvature, top_k=top_k, refine=refine,
                                   times=(clock, fitted, searched))
         except NoFeasibleGrasp as err:
-            errors.append(str(err))
+            errors.append(err)  # its reason worked out only if every attempt fails (_Unexplained)
             continue
         if guards is not safeguards:
             note = NOTE_UNBALANCED.format(limit=safeguards.max_imbalance, share=plan.quality.imbalance)
@@ -191,8 +192,9 @@ NOTE_UNBALANCED = ("no pose balances the squeeze within max_imbalance = {limit:g
                    "finger pushing equally hard, {share:.2f} of their force is left to friction")
 
 
-def _no_grasp(errors: list[str], counts: int, fewest: int) -> str:
+def _no_grasp(errors: list[NoFeasibleGrasp], counts: int, fewest: int) -> str:
     """The first attempt's reason, the small-object rule's last, and the search without the squeeze's balance."""
+    errors = [str(error) for error in errors]
     message = errors[0]
     if counts > 1:
         message += f"; with the small-object rule, down to {fewest} touching fingers: {errors[counts - 1]}"
@@ -312,9 +314,31 @@ def _reevaluate_best(model, hand, screen: PoseEvaluation, n: int, curvature, d_m
         if result.feasible.any():
             return result
         if n >= len(order) or descended >= tol.MAX_DESCENT_POSES:
-            raise NoFeasibleGrasp(_diagnose_descent(hand, last, descended, descent) if last is not None
-                                  else _diagnose_exact(result, safeguards))
+            if last is not None:
+                raise _Unexplained(partial(_diagnose_descent, hand, last, descended, descent))
+            raise NoFeasibleGrasp(_diagnose_exact(result, safeguards))
         n *= 4
+
+
+class _Unexplained(NoFeasibleGrasp):
+    """An attempt of :func:`search` that failed, its reason worked out when first asked for.
+
+    The descent's diagnosis checks the poses again without the scene's obstacles (a new map, a few
+    milliseconds); a search whose later attempt plans never needs it.
+    """
+
+    def __init__(self, explain):
+        RuntimeError.__init__(self)
+        self._explain, self._reason = explain, None
+
+    @property
+    def reason(self) -> str:
+        if self._reason is None:
+            self._reason = self._explain()
+        return self._reason
+
+    def __str__(self) -> str:
+        return self.reason
 
 
 def _descended(hand: Hand, descent: Descent, pose) -> DescentCheck:
