@@ -226,7 +226,7 @@ def imbalance(normals, valid=None) -> np.ndarray:
     >>> round(float(imbalance([[[-1.0, 0.0], *fingers]])[0]), 3)
     0.376
     """
-    _, n, ok = _check_contact_batch(None, normals, valid)
+    n, ok = _check_normal_batch(normals, valid)
     count = ok.sum(axis=1)
     net = np.linalg.norm(np.where(ok[..., None], n, 0.0).sum(axis=1), axis=1)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -270,7 +270,7 @@ def epsilon_many(
     """
     metric = _check_metric(metric)
     mu = _check_mu(mu)
-    p, n, ok = _check_contact_batch(_as_float(points, "points"), normals, valid)
+    p, n, ok = _check_contact_batch(points, normals, valid)
     c, r = _frame(p, ok, centre, rho)
     w = _edge_wrenches(p, n, mu, c, r)
     if metric == "L1":
@@ -427,27 +427,37 @@ def _check_contacts(points, normals) -> tuple[np.ndarray, np.ndarray]:
     return p, n
 
 
-def _check_contact_batch(points, normals, valid) -> tuple[np.ndarray | None, np.ndarray, np.ndarray]:
-    """Points (None if not given), unit normals (g, k, 2) with invalid entries neutralised, the valid mask (g, k)."""
-    n, p = _as_float(normals, "normals"), None
-    if points is None:
-        if n.ndim != 3 or n.shape[2] != 2:
-            raise QualityError(f"normals must be a (p, n, 2) array, got shape {n.shape}")
-    else:
-        p = _as_float(points, "points")
-        if p.ndim != 3 or p.shape[2] != 2:
-            raise QualityError(f"points must be a (p, n, 2) array, got shape {p.shape}")
-        if n.shape != p.shape:
-            raise QualityError(f"normals must have the shape of points {p.shape}, got {n.shape}")
-    try:
-        ok = np.ones(n.shape[:2], bool) if valid is None else np.asarray(valid)
-    except (TypeError, ValueError):
-        raise QualityError(f"valid must be a {n.shape[:2]} bool array") from None
-    if ok.shape != n.shape[:2] or ok.dtype != bool:
-        raise QualityError(f"valid must be a {n.shape[:2]} bool array, got {ok.dtype} {ok.shape}")
+def _check_contact_batch(points, normals, valid) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Points, unit normals (g, k, 2) with invalid entries neutralised, and the valid mask (g, k)."""
+    p, n = _as_float(points, "points"), _as_float(normals, "normals")
+    if p.ndim != 3 or p.shape[2] != 2:
+        raise QualityError(f"points must be a (p, n, 2) array, got shape {p.shape}")
+    if n.shape != p.shape:
+        raise QualityError(f"normals must have the shape of points {p.shape}, got {n.shape}")
+    ok = _valid_mask(valid, p.shape[:2])
     # Invalid contacts may hold NaN; give them harmless values, the mask drops them later.
-    p, n = _check_values(None if p is None else np.where(ok[..., None], p, 0.0), np.where(ok[..., None], n, 1.0))
+    p, n = _check_values(np.where(ok[..., None], p, 0.0), np.where(ok[..., None], n, 1.0))
     return p, n, ok
+
+
+def _check_normal_batch(normals, valid) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_check_contact_batch` for normals alone: unit normals (g, k, 2) and the valid mask (g, k)."""
+    n = _as_float(normals, "normals")
+    if n.ndim != 3 or n.shape[2] != 2:
+        raise QualityError(f"normals must be a (p, n, 2) array, got shape {n.shape}")
+    ok = _valid_mask(valid, n.shape[:2])
+    return _check_values(None, np.where(ok[..., None], n, 1.0))[1], ok
+
+
+def _valid_mask(valid, shape) -> np.ndarray:
+    """(g, k) bool: which contacts exist (all when ``valid`` is None)."""
+    try:
+        ok = np.ones(shape, bool) if valid is None else np.asarray(valid)
+    except (TypeError, ValueError):
+        raise QualityError(f"valid must be a {shape} bool array") from None
+    if ok.shape != shape or ok.dtype != bool:
+        raise QualityError(f"valid must be a {shape} bool array, got {ok.dtype} {ok.shape}")
+    return ok
 
 
 def _check_values(p: np.ndarray | None, n: np.ndarray) -> tuple[np.ndarray | None, np.ndarray]:

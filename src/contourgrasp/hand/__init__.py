@@ -99,8 +99,8 @@ class Hand:
                 1 <= self.min_touching <= n):
             raise HandError(f"hand {self.name!r}: min_touching must be in 1..{n}, got {self.min_touching!r}")
         check.bounded(f"hand {self.name!r}: miss_penalty", self.miss_penalty, tol.MAX_GAIN, error=HandError)
-        object.__setattr__(self, "max_imbalance", float(
-            check.bounded(f"hand {self.name!r}: max_imbalance", self.max_imbalance, 1.0, "", error=HandError)))
+        share = check.bounded(f"hand {self.name!r}: max_imbalance", self.max_imbalance, 1.0, "", error=HandError)
+        object.__setattr__(self, "max_imbalance", share)
         if len({f.name for f in self.fingers}) != n:
             raise HandError(f"hand {self.name!r}: finger names must be unique")
         self._check_body()
