@@ -395,6 +395,10 @@ HAND_MAX_IMBALANCE = 0.25
 #: three, the strawberry still had no plan.
 SMALL_OBJECT_TOUCHING = 2
 
+#: Chords per quarter circle of the arcs contour.grow_polygon puts at convex corners (shapely's quad_segs): a 9 mm
+#: fingertip's arc deviates from its chords by 9 mm x (1 - cos(pi / 32)) = 0.04 mm.
+GROWTH_ARC_SEGMENTS = 8
+
 #: Closing sweep (synthesis.sweep): closing progresses sampled per finger, and how much earlier than its tip's ball
 #: (radius + this, m) a finger's chain may meet the object before the pose counts as "a link touches first".
 SWEEP_SAMPLES = 12

@@ -1,3 +1,4 @@
+import math
 import time
 import warnings
 
@@ -250,3 +251,29 @@ def test_repair_returns_points_or_a_contour_error(points):
     except InputError:
         return
     assert np.isfinite(repaired).all()
+
+
+def test_a_grown_square_has_the_minkowski_area_and_every_vertex_at_the_distance():
+    side, r = 0.1, 0.01
+    square = np.array([[0, 0], [side, 0], [side, side], [0, side]], dtype=float)
+    grown = contour.grow_polygon(square, r)
+    n = 4 * tol.GROWTH_ARC_SEGMENTS  # the four quarter discs' chords make one regular n-gon inscribed in a circle
+    exact = side**2 + 4 * side * r + n / 2 * r**2 * math.sin(2 * math.pi / n)  # the square, four strips, the n-gon
+    assert contour.signed_area(grown) == pytest.approx(exact, rel=1e-12)
+    inside = np.clip(grown, 0, side)  # the nearest point of the square
+    assert np.linalg.norm(grown - inside, axis=1) == pytest.approx(r, abs=1e-12)
+
+
+def test_growth_keeps_the_orientation_and_a_disc_grows_by_the_distance():
+    circle = disc(0.02, n=400)
+    for points in (circle, circle[::-1]):
+        grown = contour.grow_polygon(points, 0.009)
+        assert np.sign(contour.signed_area(grown)) == np.sign(contour.signed_area(points))
+        assert np.linalg.norm(grown, axis=1) == pytest.approx(0.029, abs=2e-5)
+    assert np.array_equal(contour.grow_polygon(circle, 0.0), circle)
+
+
+@pytest.mark.parametrize("distance", [-0.001, math.nan, "1", tol.MAX_SEARCH_LENGTH * 2])
+def test_a_bad_growth_distance_is_refused_by_name(distance):
+    with pytest.raises(ContourError, match="distance"):
+        contour.grow_polygon(disc(0.02, n=50), distance)

@@ -27,6 +27,7 @@ def test_plan_json_schema():
                    "virtual_start", "missed", "gap"}
     assert all(set(f) == finger_keys for f in data["fingers"])
     assert len(data["efd"]["coefficients"]) == data["efd"]["harmonics"] == 4
+    assert data["efd"]["outline_grown_by"] == 0.0  # the fingertips reach the can as points
     assert len(data["alternatives"]) == 3
     assert data["pose"]["x"] == pytest.approx(float(plan.pose[0]))
 

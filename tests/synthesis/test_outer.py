@@ -243,3 +243,28 @@ def test_an_attempts_reason_is_worked_out_once_and_only_when_asked():
     failure = _Unexplained(lambda: calls.append(1) or "blocked")
     assert calls == [] and isinstance(failure, NoFeasibleGrasp)
     assert str(failure) == failure.reason == "blocked" and calls == [1]
+
+
+def _pincer(radius: float) -> cg.Hand:
+    """Two fingers closing on a line toward each other; their travels end 20 mm apart."""
+    return cg.Hand("pincer", (cg.Finger("left", start=(-0.06, 0.0), trajectory=cg.Ray((1.0, 0.0)), travel=0.05,
+                                        radius=radius),
+                              cg.Finger("right", start=(0.06, 0.0), trajectory=cg.Ray((-1.0, 0.0)), travel=0.05,
+                                        radius=radius)), min_touching=2)
+
+
+def test_the_small_object_rule_closes_fingertip_balls_on_an_object_the_points_cannot_reach():
+    grid = {"xy_step": 0.002, "yaw_step": math.radians(15), "d_max": 0.01}
+    small = disc(0.005)  # 10 mm across: the points' travels end 20 mm apart
+    with pytest.raises(NoFeasibleGrasp, match="onto the object within their travel"):
+        cg.synthesize(small, _pincer(0.006), small_objects=False, **grid)
+    plan = cg.synthesize(small, _pincer(0.006), small_objects=True, **grid)
+    assert plan.grown == 0.006 and "grown by 6.0 mm" in plan.notes[-1]
+    assert np.array_equal(plan.contour, efd.clean_polygon(small))
+    for finger in plan.fingers:  # each tip's centre stops one radius off the object: 5 + 6 mm from its centre
+        assert not finger.missed and np.linalg.norm(finger.grasp_point) == pytest.approx(0.011, abs=2e-4)
+    with pytest.raises(NoFeasibleGrasp, match=r"as balls \(the outline grown by 6.0 mm\): no pose brings 2"):
+        cg.synthesize(disc(0.003), _pincer(0.006), small_objects=True, **grid)  # 3 + 6 mm < 10 mm
+    with pytest.raises(NoFeasibleGrasp) as points:  # fingers of radius 0 are points: nothing to grow
+        cg.synthesize(small, _pincer(0.0), small_objects=True, **grid)
+    assert "balls" not in str(points.value)

@@ -1,4 +1,4 @@
-"""The input polygon: checks that make it safe to model, self-intersections and their repair.
+"""The input polygon: checks that make it safe to model, self-intersections and their repair, growth.
 
 :func:`clean_polygon` is the one gate every contour passes before it is
 fitted (:func:`contourgrasp.contour.fit`), so that nothing after it meets a
@@ -13,6 +13,7 @@ import math
 import warnings
 
 import numpy as np
+import shapely
 
 from .. import tolerances as tol
 from .. import validation
@@ -110,6 +111,48 @@ def clean_polygon(points, *, check_units: bool = True) -> np.ndarray:
             stacklevel=2,
         )
     return pts
+
+
+def grow_polygon(points, distance: float) -> np.ndarray:
+    """The polygon grown by ``distance``: the outline of every point within ``distance`` of it.
+
+    The Minkowski sum with a disc (shapely's round buffer, ``tolerances.GROWTH_ARC_SEGMENTS`` chords per
+    quarter circle): convex corners become arcs of radius ``distance``, concave notches narrower than
+    twice ``distance`` close. Where a ball of radius ``distance`` first touches the polygon, its centre
+    lies on the grown outline, so a fingertip ball's centre path meets the grown outline where the ball
+    meets the object (the small-object rule of :func:`contourgrasp.synthesis.search`).
+
+    Parameters
+    ----------
+    points : (n, 2) float
+        A simple polygon (as :func:`clean_polygon` returns it), in either orientation, meters.
+    distance : float
+        How far to grow it, m: at least 0, at most ``tolerances.MAX_SEARCH_LENGTH``.
+
+    Returns
+    -------
+    (m, 2) float
+        The grown polygon's vertices, its first not repeated, in the input's orientation.
+
+    Raises
+    ------
+    ContourError
+        Bad points or a distance that is not a number in range, naming it.
+
+    Examples
+    --------
+    >>> square = np.array([[0.0, 0.0], [0.1, 0.0], [0.1, 0.1], [0.0, 0.1]])
+    >>> grown = grow_polygon(square, 0.01)
+    >>> round(float(np.ptp(grown[:, 0])), 6), signed_area(grown) > 0
+    (0.12, True)
+    """
+    pts = _finite_points(points)
+    distance = validation.bounded("distance", distance, tol.MAX_SEARCH_LENGTH, " m", error=ContourError)
+    if distance == 0:
+        return pts.copy()
+    grown = shapely.Polygon(pts).buffer(distance, quad_segs=tol.GROWTH_ARC_SEGMENTS)
+    out = np.asarray(grown.exterior.coords, dtype=float)[:-1]
+    return out if (signed_area(out) > 0) == (signed_area(pts) > 0) else out[::-1]
 
 
 def first_self_intersection(points: np.ndarray) -> tuple[int, int] | None:

@@ -62,6 +62,7 @@ def plan_to_dict(plan: GraspPlan) -> dict:
             "C0": plan.efd.C0,
             "T": plan.efd.T,
             "coefficients": plan.efd.coefficients.tolist(),
+            "outline_grown_by": plan.grown,
         },
         "grid": {
             "xy_step": plan.grid.xy_step,

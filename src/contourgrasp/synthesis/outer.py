@@ -109,7 +109,14 @@ def search(
         thumb and the fingers opposite it reach the object. With ``max_imbalance`` the same rule
         plans the thumb against the one or two fingers that balance it on objects of any size
         (four fingers along one side outpush one thumb). The plan's ``hand`` has the
-        ``min_touching`` it was planned with.
+        ``min_touching`` it was planned with. Last, when even the fewest fingers cannot reach the
+        object within their travel, the fingertips are taken as what they are, balls of the
+        fingers' ``radius``: a ball touches the object when its centre meets the outline grown by
+        its radius (:func:`~contourgrasp.contour.grow_polygon`), so the search is repeated on that
+        outline, grown by the smallest radius (a finger of radius 0 is a point: no growth). The
+        thesis's point fingertips cannot close on an object smaller than the gap their travels
+        leave (35 mm between the five-finger hand's thumb and index); the balls of a real hand do.
+        The plan's ``grown`` says so, and its notes.
     descent : Descent, optional
         The scene's height map and the grasp height: a pose is feasible only if the open hand,
         lowered along the approach axis until its lowest fingertip is at ``descent.tip_height``,
@@ -159,6 +166,30 @@ def search(
     clock = time.perf_counter()
     small_objects = check.flag("small_objects", small_objects, error=PlannerError)
     contour = efd_model.clean_polygon(contour_xy)
+    outline = partial(_search_outline, hand=hand, grid=grid, safeguards=safeguards, descent=descent,
+                      harmonics=harmonics, curvature=curvature, small_objects=small_objects, top_k=top_k,
+                      refine=refine, clock=clock)
+    try:
+        return outline(contour)
+    except _OutOfReach as points:
+        radius = min(f.radius for f in hand.fingers)
+        if not small_objects or radius <= 0:
+            raise NoFeasibleGrasp(points.reason) from None
+        try:
+            plan = outline(efd_model.grow_polygon(contour, radius))
+        except NoFeasibleGrasp as balls:
+            why = balls.fewest if isinstance(balls, _OutOfReach) else balls.reason
+            raise NoFeasibleGrasp(f"{points.reason}; with the fingertips as balls (the outline grown by "
+                                  f"{1000 * radius:.1f} mm): {why}") from None
+    note = NOTE_BALLS.format(radius=1000 * radius)
+    return replace(plan, contour=contour, grown=radius, search_notes=plan.search_notes + (note,))
+
+
+def _search_outline(contour, *, hand: Hand, grid: SearchGrid, safeguards: Safeguards, descent: Descent | None,
+                    harmonics, curvature, small_objects: bool, top_k: int, refine: bool, clock: float) -> GraspPlan:
+    """:func:`search` on one cleaned outline: fit, screen, then each attempt of the small-object rule and the
+    squeeze's balance in turn. Raises :class:`_OutOfReach` when, with the fewest touching fingers tried, no
+    pose brings them onto the object within their travel."""
     if harmonics == "adaptive":
         harmonics = efd_model.choose_harmonics(contour, validate=False)
     model = efd_model.fit(contour, harmonics, validate=False)
@@ -184,7 +215,25 @@ def search(
             note = NOTE_UNBALANCED.format(limit=safeguards.max_imbalance, share=plan.quality.imbalance)
             plan = replace(plan, safeguards=safeguards, search_notes=(note,))
         return plan
-    raise NoFeasibleGrasp(_no_grasp(errors, len(counts), fewest))
+    reason = _no_grasp(errors, len(counts), fewest)
+    if isinstance(errors[len(counts) - 1], _OutOfReach):
+        raise _OutOfReach(reason, fewest=str(errors[len(counts) - 1]))
+    raise NoFeasibleGrasp(reason)
+
+
+class _OutOfReach(NoFeasibleGrasp):
+    """No pose brings the fingers asked for onto the object within their travel (the object is too small);
+    ``fewest`` is the reason with the fewest fingers tried."""
+
+    def __init__(self, reason: str, *, fewest: str | None = None):
+        super().__init__(reason)
+        self.fewest = reason if fewest is None else fewest
+
+
+#: The note of a plan the small-object rule made with the fingertips as balls.
+NOTE_BALLS = ("no pose brings the fingertips, as points, onto the object within their travel: planned on its "
+              "outline grown by {radius:.1f} mm, the fingers' smallest radius (grasp points are the tips' centres "
+              "when their balls first touch it)")
 
 
 #: The note of a plan whose squeeze no pose could balance within ``max_imbalance``.
@@ -223,7 +272,7 @@ def _search_fitted(model: EFD, contour, hand: Hand, screen: PoseEvaluation, grid
     """
     clock, fitted, searched = times
     if not screen.feasible.any():
-        raise NoFeasibleGrasp(_diagnose(screen, hand, grid))
+        raise _no_pose(screen, hand, grid)
     result = _reevaluate_best(model, hand, screen, max(tol.REFINE_CANDIDATES, 4 * top_k), curvature, grid.d_min,
                               safeguards, descent)
     ranked = distinct_best(result, grid, top_k)
@@ -425,20 +474,20 @@ def _cost(result: PoseEvaluation, i: int) -> Cost:
     )
 
 
-def _diagnose(result: PoseEvaluation, hand: Hand, grid: SearchGrid) -> str:
-    """Name the first constraint that leaves no pose standing."""
+def _no_pose(result: PoseEvaluation, hand: Hand, grid: SearchGrid) -> NoFeasibleGrasp:
+    """The failure naming the first constraint that leaves no pose standing (:class:`_OutOfReach` for reach)."""
     n = len(result.poses)
     if not result.starts_outside.any():
-        return (f"no pose keeps every fingertip outside the object ({n} poses tried): "
-                "the object is larger than the hand")
+        return NoFeasibleGrasp(f"no pose keeps every fingertip outside the object ({n} poses tried): "
+                               "the object is larger than the hand")
     reach = result.starts_outside & result.reaches
     if not reach.any():
         names = [f.name for f in hand.fingers if f.required]
         extra = f" including {', '.join(names)}" if names else ""
-        return (f"no pose brings {hand.min_touching} fingers{extra} onto the object within their travel "
-                f"({n} poses tried): the object is too small or too far from the hand's grasp region")
-    return (f"every pose that reaches the object starts a fingertip closer than D_min = {grid.d_min} m "
-            f"to its grasp point ({int(reach.sum())} poses reach it)")
+        return _OutOfReach(f"no pose brings {hand.min_touching} fingers{extra} onto the object within their "
+                           f"travel ({n} poses tried): the object is too small or too far from the hand's grasp region")
+    return NoFeasibleGrasp(f"every pose that reaches the object starts a fingertip closer than D_min = {grid.d_min} m "
+                           f"to its grasp point ({int(reach.sum())} poses reach it)")
 
 
 def _contacts(model: EFD, hand: Hand, result: PoseEvaluation, i: int, mode: CurvatureMode):

@@ -155,6 +155,10 @@ class GraspPlan:
     hand : Hand
     contour : (n, 2) float
         The input polygon, cleaned, in its input orientation.
+    grown : float
+        How far the outline ``efd`` models was grown from ``contour``, m: 0, or the fingers' smallest
+        radius when the small-object rule planned the fingertips as balls
+        (:func:`~contourgrasp.contour.grow_polygon`); the grasp points are then the tips' centres.
     curvature_mode : str
     grid : SearchGrid
     alternatives : tuple of Alternative
@@ -198,6 +202,7 @@ class GraspPlan:
     quality: GraspQuality
     descent: DescentCheck | None = None
     search_notes: tuple[str, ...] = ()
+    grown: float = 0.0
 
     @property
     def notes(self) -> tuple[str, ...]:
