@@ -398,6 +398,10 @@ SMALL_OBJECT_TOUCHING = 2
 #: Chords per quarter circle of the arcs contour.grow_polygon puts at convex corners (shapely's quad_segs): a 9 mm
 #: fingertip's arc deviates from its chords by 9 mm x (1 - cos(pi / 32)) = 0.04 mm.
 GROWTH_ARC_SEGMENTS = 8
+#: contour.grow_polygon resamples a polygon of more points than this by arc length first: shapely's buffer of a
+#: jagged 500-point star takes 0.4 s, of 2,000 points 11 s; an object small enough for the growth to be needed
+#: (a few cm across) is then outlined every 0.3 mm or finer.
+MAX_GROWTH_POINTS = 500
 
 #: Closing sweep (synthesis.sweep): closing progresses sampled per finger, and how much earlier than its tip's ball
 #: (radius + this, m) a finger's chain may meet the object before the pose counts as "a link touches first".

@@ -277,3 +277,15 @@ def test_growth_keeps_the_orientation_and_a_disc_grows_by_the_distance():
 def test_a_bad_growth_distance_is_refused_by_name(distance):
     with pytest.raises(ContourError, match="distance"):
         contour.grow_polygon(disc(0.02, n=50), distance)
+
+
+def test_growing_a_jagged_outline_of_the_most_points_allowed_is_bounded():
+    """Shapely's buffer of a 2,000-point star took 11 s: the growth resamples to MAX_GROWTH_POINTS first."""
+    theta = np.linspace(0, 2 * np.pi, tol.MAX_CONTOUR_POINTS, endpoint=False)
+    radius = 0.003 * (1 + 0.5 * (np.arange(len(theta)) % 2))  # 10,000 points zigzagging between 3 and 4.5 mm
+    star = contour.clean_polygon(np.c_[radius * np.cos(theta), radius * np.sin(theta)])
+    started = time.perf_counter()
+    grown = contour.grow_polygon(star, 0.006)
+    assert time.perf_counter() - started < 10.0  # an order of magnitude; a second or less here
+    reach = np.linalg.norm(grown, axis=1)  # resampled points lie on the star: no farther out than its tips grown,
+    assert reach.max() <= 0.0105 + 1e-9 and reach.min() >= 0.009 - 1e-4  # and its 3 mm core is grown by 6 mm

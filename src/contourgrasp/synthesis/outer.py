@@ -176,7 +176,8 @@ def search(
         if not small_objects or radius <= 0:
             raise NoFeasibleGrasp(points.reason) from None
         try:
-            plan = outline(efd_model.grow_polygon(contour, radius))
+            # the one gate every outline passes before its fit: growth can triple a jagged outline's vertices
+            plan = outline(efd_model.clean_polygon(efd_model.grow_polygon(contour, radius), check_units=False))
         except NoFeasibleGrasp as balls:
             why = balls.fewest if isinstance(balls, _OutOfReach) else balls.reason
             raise NoFeasibleGrasp(f"{points.reason}; with the fingertips as balls (the outline grown by "
