@@ -1,6 +1,6 @@
 """Planning time per frame (issue 6: under 100 ms): `plan_grasp` on simulated frames, per planner.
 
-One simulated RGB-D frame per thesis object (seed 3, depth noise on), planned with
+One simulated RGB-D frame per thesis object (seed 3 unless ``--seed``, depth noise on), planned with
 the `five-finger-linear` hand: perception, synthesis and the 6-DoF pose, exactly
 what a bench trial's planner does. Prints, per planner and object, the median
 wall time of 5 runs after a warm-up, and the synthesis's share (its
@@ -12,7 +12,7 @@ included.
 
 Usage::
 
-    .venv/bin/python benchmarks/planning_time.py [--planners paper,default] [--cpu] [--real] [--objects ...]
+    .venv/bin/python benchmarks/planning_time.py [--planners paper,default] [--cpu] [--real] [--objects ...] [--seed N]
 
 ``--objects`` takes the bench's object names (the thesis's five by default; ``ycb:<id>`` for a YCB
 object, ``ycb-train`` for the whole training split); a frame without a plan reads "nan ms".
@@ -43,10 +43,10 @@ OBJECTS = ("can", "case", "bottle", "stone1", "stone2")
 RUNS, SEED = 5, 3
 
 
-def simulated_frame(obj: str):
+def simulated_frame(obj: str, seed: int = SEED):
     """(rgb, depth, intrinsics) of the simulated frame of ``obj`` (a bench object name, e.g. ``ycb:025_mug``)."""
-    scene = build_scene(load_object(obj), seed=SEED)
-    return (*render(scene, noise=True, seed=SEED), scene.camera.intrinsics)
+    scene = build_scene(load_object(obj), seed=seed)
+    return (*render(scene, noise=True, seed=seed), scene.camera.intrinsics)
 
 
 def frame_times(planner: str, frame, clock=time.perf_counter) -> tuple[float, float]:
@@ -84,10 +84,11 @@ def main() -> None:
     parser.add_argument("--real", action="store_true", help="also the real frames of ../shared/data")
     parser.add_argument("--objects", default=",".join(OBJECTS),
                         help="comma list of bench object names or sets (e.g. ycb:025_mug, ycb-train)")
+    parser.add_argument("--seed", type=int, default=SEED, help="the bench trial's seed of every simulated frame")
     args = parser.parse_args()
     cv2.setNumThreads(1)
     clock = time.process_time if args.cpu else time.perf_counter
-    frames = {obj: simulated_frame(obj) for obj in object_names(args.objects)} | (real_frames() if args.real else {})
+    frames = {obj: simulated_frame(obj, args.seed) for obj in object_names(args.objects)} | (real_frames() if args.real else {})
     print(f"{'CPU' if args.cpu else 'wall'} time of plan_frame, median of {RUNS} (synthesis: its timing_ms.total, "
           f"wall time)\n")
     print("| planner | " + " | ".join(frames) + " |")
