@@ -234,11 +234,11 @@ def plan_frame(
     closing = validation.flag("closing_obstacles", closing_obstacles, error=PlannerError)
     spec = Descent(heights, *asked, sweep=sweep, closing=closing) if descent and asked is not None else None
     slicing = validation.choice("slice_contour", slice_contour, SLICE_CONTOUR, error=PlannerError)
-    section = perception.cross_section(heights, asked[0]) if slicing and asked is not None else None
-    plan = search(metric.contour_xy if section is None or slicing == "unbalanced" else section, hand,
-                  descent=spec, **synthesis_options)
-    if slicing == "unbalanced" and section is not None and not plan.balanced:
-        plan = _balanced_on_section(plan, section, hand, spec, asked[0], synthesis_options)
+    section = perception.cross_section(heights, asked[0]) if slicing is True and asked is not None else None
+    plan = search(metric.contour_xy if section is None else section, hand, descent=spec, **synthesis_options)
+    if slicing == "unbalanced" and asked is not None and not plan.balanced:
+        plan = _balanced_on_section(plan, perception.cross_section(heights, asked[0]), hand, spec, asked[0],
+                                    synthesis_options)
     tip_height = None if asked is None else asked[0] if plan.descent is None else float(plan.descent.tip_height[0])
     depth_at = (metric.approach_depth if tip_height is None
                 else _palm_depth(metric, heights, hand, plan.pose, tip_height))
@@ -259,6 +259,8 @@ NOTE_SECTION = ("no pose balances the squeeze on the outline seen: planned on th
 
 def _balanced_on_section(plan, section, hand: Hand, descent, height: float, options):
     """The plan on ``section`` if a pose balances the squeeze there, else ``plan`` (the outline seen's)."""
+    if section is None:
+        return plan
     try:
         sliced = search(section, hand, descent=descent, **options)
     except NoFeasibleGrasp:
