@@ -25,8 +25,10 @@ from .io.planner_file import load_planner, planner_names, synthesis_options
 from .io.plan_file import atomic_outputs, plan_to_dict, write_json
 
 EXIT_OK, EXIT_INPUT, EXIT_INFEASIBLE = 0, 2, 3
-#: The palm axes hand-from-model and bench --hand-model accept as the approach.
-APPROACHES = ("x", "-x", "y", "-y", "z", "-z")
+#: The palm axes hand-from-model and bench --hand-model accept as the approach, "level"
+#: (contourgrasp.sim.model_hand.LEVEL: the fingers' axis turned until the thumb's open tip is as deep as the others')
+#: and "fingers" (the axis the fingers point along, the default for a model file).
+APPROACHES = ("x", "-x", "y", "-y", "z", "-z", "level", "fingers")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -293,7 +295,9 @@ def _add_hand_from_model_parser(sub) -> None:
     derive.add_argument("--palm", metavar="BODY", help="the palm body (default: the deepest body holding every "
                                                        "fingertip)")
     derive.add_argument("--approach", choices=APPROACHES,
-                        help="the palm body's axis toward the object (default: the axis the fingers point along)")
+                        help="the palm body's axis toward the object; 'fingers': the axis the fingers point along (the "
+                             "default for a model file); 'level': that axis turned until the first fingertip's open "
+                             "tip is as deep as the others' mean (the bundled inspire's)")
     derive.add_argument("--max-imbalance", type=_non_negative_float, metavar="SHARE",
                         help="the hand's own squeeze balance, 0..1 (a planner's max_imbalance 'hand'; default: the "
                              "bundled model's, else 0.25); closing in free air cannot measure it")

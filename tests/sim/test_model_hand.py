@@ -75,6 +75,26 @@ def test_the_approach_axis_decides_the_palm_plane(sliders):
         derive_hand(sliders, fingertips=["left_tip", "right_tip"], approach="up")
 
 
+def test_the_level_reading_brings_the_inspire_thumb_as_deep_as_its_fingers():
+    from dataclasses import replace
+
+    from contourgrasp.sim.model_hand import LEVEL, close_model, model_spec
+
+    along = close_model(replace(model_spec("inspire"), approach=None)).tips[:, 0, 2]  # open tips' depths, m
+    assert along[1:].mean() - along[0] > 0.08  # along the fingers, the thumb's tip hangs a hand's width higher
+    levelled = close_model(model_spec("inspire"))
+    assert model_spec("inspire").approach == LEVEL  # the bundled reading; "fingers" gives the one along the fingers
+    assert model_spec("inspire", approach="fingers").approach is None
+    depths = levelled.tips[:, 0, 2]
+    assert depths[0] == pytest.approx(depths[1:].mean(), abs=1e-6)
+    rotation = np.asarray(levelled.mount.rotation)
+    np.testing.assert_allclose(rotation @ rotation.T, np.eye(3), atol=1e-12)
+    assert np.linalg.det(rotation) == pytest.approx(1.0)
+    # its fingers close on arcs, whose virtual starts come from the recorded closing as for rays
+    hand = derive_hand("inspire").hand
+    assert all(f.virtual_start > 0.005 for f in hand.fingers[1:]) and hand.fingers[0].virtual_start == 0.0
+
+
 @pytest.mark.parametrize("name, fingers", [("inspire", 5), ("jaco-three-finger", 3)])
 def test_bundled_models_derive_hands_within_the_tolerance(name, fingers):
     derived = derive_hand(name)

@@ -32,7 +32,10 @@ def test_mounted_model_opens_and_closes_on_its_derived_hand(name):
         scene.command([0.0, 0.0, 0.6, 0.0], min(1.0, k / 500))
         scene.step()
         nearest = np.minimum(nearest, np.linalg.norm(tips_in_hand_frame(scene, name)[:, :2] - hand.ends, axis=1))
-    assert nearest.max() < 1e-3  # every fingertip passes through its derived closed position
+    # every fingertip passes through its derived closed position: within 1 mm, or for an arc (fitted through the
+    # path's first point) within twice its fit error, the start's offset from the ellipse and the ellipse's from the path
+    fit_error = np.array([fit.error for fit in mounted.derivation.fits])
+    assert np.all(nearest < np.maximum(1e-3, 2 * fit_error)), (nearest, fit_error)
     assert set(mounted.geom_names()) <= {scene.model.geom(g).name for g in range(scene.model.ngeom)}
 
 

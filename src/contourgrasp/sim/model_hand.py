@@ -22,7 +22,13 @@ keep control 0, except those a :class:`ModelSpec` holds (a pre-shape).
 the object) is the :class:`ModelSpec`'s ``approach`` axis, or else the palm axis (+-x, +-y or +-z)
 best aligned with the mean direction from each finger's first hinge joint (the palm's origin for a
 finger without one) to its open fingertip -- the way the fingers point; x is the first of the palm's
-axes not along z, y = z x x. The origin is the palm body's origin moved along z to the palm's
+axes not along z, y = z x x. The reading ``approach = "level"`` (:data:`LEVEL`) turns that frame
+about the axis normal to z and to the offset of the first fingertip's open tip from the others'
+mean, until the two are equally deep: the hand approaches tilted so that an opposed thumb shorter
+than the fingers reaches the object with them. Our reading for a humanlike hand: along the fingers,
+the Inspire's open fingertips hang 134-147 mm below the palm and its thumb's 48 mm, so a descent
+that brings the fingers to the object leaves the thumb a hand's width above it; levelled, they meet
+it together (README, "The bench on the models", for what it lifts). The origin is the palm body's origin moved along z to the palm's
 underside: the largest z of the palm's own collision geoms (those of bodies welded to it), but no
 deeper than the shallowest finger's first joint (posts below the palm carry knuckles), so z = 0 is
 the plane of the palm's underside as in :mod:`contourgrasp.hand`; the palm plane is the plane z = 0,
@@ -73,6 +79,10 @@ from .scene import TIMESTEP, mujoco_warnings  # noqa: E402
 SETTLE_TIME = 2.0
 #: Miss penalty of a derived hand (the five-finger-linear preset's).
 MISS_PENALTY = 250.0
+#: The approach reading that levels the first fingertip (the thumb) with the others (module docstring).
+LEVEL = "level"
+#: The approach reading along the fingers (a ModelSpec's None), to override a bundled model's.
+ALONG_FINGERS = "fingers"
 
 
 @dataclass(frozen=True)
@@ -95,7 +105,8 @@ class ModelSpec:
         pre-shape, such as a thumb's opposition); any other actuator keeps control 0.
     approach : str or None
         The palm axis (``"x"``, ``"-x"``, ..., ``"-z"``) that is the approach (the hand frame's z);
-        None: the axis the fingers point along (module docstring).
+        None: the axis the fingers point along; :data:`LEVEL`: that axis turned until the first
+        fingertip is as deep as the others (module docstring).
     max_imbalance : float
         The derived hand's :attr:`Hand.max_imbalance`: closing the model in free air does not show
         how unbalanced a squeeze its drive holds, so it is chosen on the bench, not derived.
@@ -119,7 +130,8 @@ def _bundled(folder: str, xml: str, fingers, **options) -> ModelSpec:
 _INSPIRE_FINGERS = ("thumb", "index", "middle", "ring", "pinky")
 
 #: The hand models shipped with the package (from robosuite 1.5.2, MIT; data/models/README.md). The
-#: Inspire hand's thumb rotation is its own motor: held opposed (the high end), not part of the synergy. The Jaco's
+#: Inspire hand's thumb rotation is its own motor: held opposed (the high end), not part of the synergy; it is read
+#: :data:`LEVEL` (chosen on ycb-train and the thesis's five: README, "The bench on the models"). The Jaco's
 #: fingers each hold their own position: its squeeze's balance is off (max_imbalance 1), chosen on its ycb-train
 #: and thesis's-five trials (benchmarks/balance_sweep.md).
 MODELS = {
@@ -128,7 +140,7 @@ MODELS = {
         names=("thumb", "index", "middle", "ring", "little"),
         actuators=tuple(f"{f}_{j}_drive" for f in _INSPIRE_FINGERS[1:] for j in ("proximal", "distal"))
         + ("thumb_proximal_2_drive", "thumb_middle_drive", "thumb_distal_drive"),
-        hold=(("thumb_proximal_1_drive", 1.0),)),
+        hold=(("thumb_proximal_1_drive", 1.0),), approach=LEVEL),
     "jaco-three-finger": _bundled("jaco_three_finger", "jaco_three_finger_gripper.xml", ("thumb", "index", "pinky"),
                                   palm="right_gripper", names=("thumb", "index", "pinky"), max_imbalance=1.0),
 }
@@ -157,7 +169,7 @@ def model_spec(model, *, fingertips=None, actuators=None, palm=None, approach=No
     if actuators is not None:
         spec = replace(spec, actuators=tuple(actuators))
     if approach is not None:
-        spec = replace(spec, approach=approach)
+        spec = replace(spec, approach=None if approach == ALONG_FINGERS else approach)
     if max_imbalance is not None:
         spec = replace(spec, max_imbalance=max_imbalance)
     return replace(spec, palm=palm) if palm is not None else spec
@@ -340,7 +352,11 @@ def close_model(spec: ModelSpec, *, close_time: float = 1.0, hold_time: float = 
                         f"({', '.join(m.actuator(a).name for a in acts)}) close (it moves "
                         f"{1000 * moved[i]:.2f} mm, at least {1000 * tol.FINGER_MOVED:g} mm)")
     roots = np.array([joint_records[i][0, 0] if len(c) else np.zeros(3) for i, c in enumerate(chains)])
-    axes = _hand_axes(tips_palm[:, 0] - roots if spec.approach is None else _axis(spec.approach, source)[None])
+    if spec.approach in (None, LEVEL):
+        axes = _hand_axes(tips_palm[:, 0] - roots)
+        axes = _levelled(axes, tips_palm[:, 0]) if spec.approach == LEVEL else axes
+    else:
+        axes = _hand_axes(_axis(spec.approach, source)[None])
     palm_geoms = _palm_geoms(m, d, palm, subtree, axes, collides)
     knuckles = [float(joint_records[i][0, 0] @ axes[2]) for i, c in enumerate(chains) if len(c)]
     depth = 0.0 if palm_geoms is None else min([float(palm_geoms[:, 2].max())] + knuckles)
@@ -536,8 +552,21 @@ def _axis(name: str, source: str) -> np.ndarray:
     """The palm axis called ``name`` ("x", "-y", ...) as a unit 3-vector."""
     axes = {f"{sign}{a}": (-1.0 if sign else 1.0) * np.eye(3)[i] for i, a in enumerate("xyz") for sign in ("", "-")}
     if name not in axes:
-        raise HandFileError(f"{source}: approach must be one of {', '.join(axes)}, got {name!r}")
+        raise HandFileError(f"{source}: approach must be one of {', '.join([*axes, LEVEL, ALONG_FINGERS])}, "
+                            f"got {name!r}")
     return axes[name]
+
+
+def _levelled(axes: np.ndarray, open_tips: np.ndarray) -> np.ndarray:
+    """``axes`` turned about the axis normal to z and to the first open tip's offset from the others' mean, until
+    that tip and the others' mean are equally deep (the reading :data:`LEVEL`)."""
+    offset = open_tips[0] - open_tips[1:].mean(axis=0)
+    offset /= np.linalg.norm(offset)
+    z = axes[2] - (axes[2] @ offset) * offset
+    z /= np.linalg.norm(z)
+    x = axes[0] - (axes[0] @ z) * z
+    x /= np.linalg.norm(x)
+    return np.stack([x, np.cross(z, x), z])
 
 
 def _hand_axes(pointing: np.ndarray) -> np.ndarray:
@@ -598,8 +627,10 @@ def _tip_radius(m, tip: tuple[str, int], collides: np.ndarray) -> float:
 
 def _with_virtual_starts(hand: Hand, closed: ClosedModel) -> Hand:
     progress = np.array([travelled(f, closed.tips[i, :, :2]) for i, f in enumerate(hand.fingers)])
-    closing = Closing(names=closed.names, travel=np.array([f.travel for f in hand.fingers]), times=closed.times,
-                      travelled=progress)
+    # an arc runs from the path's first point, which may lie off the fitted ellipse by the fit error: its
+    # nearest point to the closed tip can fall that much short of the travel, which is the finger closed
+    reached = np.minimum([f.travel for f in hand.fingers], progress.max(axis=1))
+    closing = Closing(names=closed.names, travel=reached, times=closed.times, travelled=progress)
     starts = derive_virtual_starts(closing)
     fingers = tuple(replace(f, virtual_start=round(starts[f.name], 4) + 0.0) for f in hand.fingers)
     return replace(hand, fingers=fingers)
