@@ -95,6 +95,19 @@ def test_the_level_reading_brings_the_inspire_thumb_as_deep_as_its_fingers():
     assert all(f.virtual_start > 0.005 for f in hand.fingers[1:]) and hand.fingers[0].virtual_start == 0.0
 
 
+def test_level_keeps_a_hand_whose_tips_are_level_and_needs_two_fingers(sliders):
+    fingers = ["left_tip", "right_tip"]
+    level = derive_hand(sliders, fingertips=fingers, approach="level").hand
+    along = derive_hand(sliders, fingertips=fingers, approach="fingers").hand
+    np.testing.assert_allclose(level.starts, along.starts, atol=1e-9)  # the sliders' tips are equally deep
+    from contourgrasp.sim.model_hand import _levelled
+
+    with pytest.raises(HandFileError, match="needs two fingertips at least, got 1"):
+        _levelled(np.eye(3), np.zeros((1, 3)), "one.xml")
+    with pytest.raises(HandFileError, match="straight along the fingers"):  # thumb 5 cm above the others, along z
+        _levelled(np.eye(3), np.array([[0.0, 0.0, 0.05], [0.0, 0.0, 0.1], [0.0, 0.0, 0.1]]), "tower.xml")
+
+
 @pytest.mark.parametrize("name, fingers", [("inspire", 5), ("jaco-three-finger", 3)])
 def test_bundled_models_derive_hands_within_the_tolerance(name, fingers):
     derived = derive_hand(name)

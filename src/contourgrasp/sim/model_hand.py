@@ -28,8 +28,9 @@ mean, until the two are equally deep: the hand approaches tilted so that an oppo
 than the fingers reaches the object with them. Our reading for a humanlike hand: along the fingers,
 the Inspire's open fingertips hang 134-147 mm below the palm and its thumb's 48 mm, so a descent
 that brings the fingers to the object leaves the thumb a hand's width above it; levelled, they meet
-it together (README, "The bench on the models", for what it lifts). The origin is the palm body's origin moved along z to the palm's
-underside: the largest z of the palm's own collision geoms (those of bodies welded to it), but no
+it together (README, "The bench on the models", for what it lifts). It needs two fingers at least,
+the first not straight along the approach from the others. The origin is the palm body's origin
+moved along z to the palm's underside: the largest z of the palm's own collision geoms (those of bodies welded to it), but no
 deeper than the shallowest finger's first joint (posts below the palm carry knuckles), so z = 0 is
 the plane of the palm's underside as in :mod:`contourgrasp.hand`; the palm plane is the plane z = 0,
 and the fingertips' paths are projected on it along z.
@@ -354,7 +355,7 @@ def close_model(spec: ModelSpec, *, close_time: float = 1.0, hold_time: float = 
     roots = np.array([joint_records[i][0, 0] if len(c) else np.zeros(3) for i, c in enumerate(chains)])
     if spec.approach in (None, LEVEL):
         axes = _hand_axes(tips_palm[:, 0] - roots)
-        axes = _levelled(axes, tips_palm[:, 0]) if spec.approach == LEVEL else axes
+        axes = _levelled(axes, tips_palm[:, 0], source) if spec.approach == LEVEL else axes
     else:
         axes = _hand_axes(_axis(spec.approach, source)[None])
     palm_geoms = _palm_geoms(m, d, palm, subtree, axes, collides)
@@ -557,12 +558,17 @@ def _axis(name: str, source: str) -> np.ndarray:
     return axes[name]
 
 
-def _levelled(axes: np.ndarray, open_tips: np.ndarray) -> np.ndarray:
+def _levelled(axes: np.ndarray, open_tips: np.ndarray, source: str) -> np.ndarray:
     """``axes`` turned about the axis normal to z and to the first open tip's offset from the others' mean, until
     that tip and the others' mean are equally deep (the reading :data:`LEVEL`)."""
+    if len(open_tips) < 2:
+        raise HandFileError(f"{source}: approach {LEVEL!r} levels the first fingertip with the others: it needs two "
+                            f"fingertips at least, got {len(open_tips)}")
     offset = open_tips[0] - open_tips[1:].mean(axis=0)
-    offset /= np.linalg.norm(offset)
-    z = axes[2] - (axes[2] @ offset) * offset
+    z = axes[2] - (axes[2] @ offset) * offset / max(float(offset @ offset), 1e-18)
+    if np.linalg.norm(z) < 1e-3:
+        raise HandFileError(f"{source}: approach {LEVEL!r}: the first fingertip lies straight along the fingers "
+                            "from the others, so no tilt levels it; name a palm axis instead")
     z /= np.linalg.norm(z)
     x = axes[0] - (axes[0] @ z) * z
     x /= np.linalg.norm(x)
