@@ -233,7 +233,8 @@ def plan_frame(
     sweep = validation.flag("closing_sweep", closing_sweep, error=PlannerError)
     closing = validation.flag("closing_obstacles", closing_obstacles, error=PlannerError)
     spec = Descent(heights, *asked, sweep=sweep, closing=closing) if descent and asked is not None else None
-    slicing = validation.choice("slice_contour", slice_contour, SLICE_CONTOUR, error=PlannerError)
+    slicing = bool(slice_contour) if isinstance(slice_contour, np.bool_) else slice_contour  # as flag() took them
+    slicing = validation.choice("slice_contour", slicing, SLICE_CONTOUR, error=PlannerError)
     section = perception.cross_section(heights, asked[0]) if slicing is True and asked is not None else None
     plan = search(metric.contour_xy if section is None else section, hand, descent=spec, **synthesis_options)
     if slicing == "unbalanced" and asked is not None and not plan.balanced:

@@ -30,10 +30,10 @@ the Inspire's open fingertips hang 134-147 mm below the palm and its thumb's 48 
 that brings the fingers to the object leaves the thumb a hand's width above it; levelled, they meet
 it together (README, "The bench on the models", for what it lifts). It needs two fingers at least,
 the first not straight along the approach from the others. The origin is the palm body's origin
-moved along z to the palm's underside: the largest z of the palm's own collision geoms (those of bodies welded to it), but no
-deeper than the shallowest finger's first joint (posts below the palm carry knuckles), so z = 0 is
-the plane of the palm's underside as in :mod:`contourgrasp.hand`; the palm plane is the plane z = 0,
-and the fingertips' paths are projected on it along z.
+moved along z to the palm's underside: the largest z of the palm's own collision geoms (those of
+bodies welded to it), but no deeper than the shallowest finger's first joint (posts below the palm
+carry knuckles), so z = 0 is the plane of the palm's underside as in :mod:`contourgrasp.hand`; the
+palm plane is the plane z = 0, and the fingertips' paths are projected on it along z.
 
 *Trajectories.* Each fingertip's path, projected on the palm plane, is fitted by a ray (eq 3.18:
 start the open tip, direction and travel to the closed tip) and, when the ray leaves the path by more
