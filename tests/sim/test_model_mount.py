@@ -3,9 +3,10 @@ import pytest
 
 from contourgrasp.sim.model_hand import MODELS
 from contourgrasp.sim.model_mount import PREFIX, mount_model
+from contourgrasp.sim.objects import soda_can
 from contourgrasp.sim.planners import make_planner
 from contourgrasp.sim.scene import build_scene
-from contourgrasp.sim.trial import run_trial
+from contourgrasp.sim.trial import STRUCK, Execution, execute_grasp, pose_matrix, run_trial
 
 
 @pytest.fixture(scope="module")
@@ -44,3 +45,30 @@ def test_a_trial_with_the_mounted_jaco_grasps_the_can(jaco):
     planner = make_planner("default", jaco.hand, seed=0)
     record = run_trial("can", seed=0, planner=planner, hand=jaco)
     assert record.cause is None and set(record.fingers_in_contact) == {"thumb", "index", "pinky"}
+
+
+def test_the_inspire_palm_below_its_frame_is_kept_clear_of_a_tall_object():
+    # read level, the Inspire's palm reaches along its fingers below z = 0 (the thumb's knuckle): the trial's own
+    # descent keeps that part, not z = 0, palm_clearance above the object's top (it struck a 12 cm can before)
+    inspire = mount_model("inspire")
+    scene = build_scene(soda_can(standing=True), seed=0, hand=inspire)
+    scene.set_hand(0.0, 0.0, 0.6, 0.0)
+    scene.step(0.01)
+    origin = scene.palm_pose()[0]
+    corners = np.concatenate([_corners(scene, scene.model.geom(name).id) for name in inspire.geom_names()
+                              if name.startswith("palm_")])
+    deepest = corners[np.argmin(corners[:, 2])]
+    assert origin[2] - deepest[2] == pytest.approx(inspire.palm_depth, abs=2e-3) and inspire.palm_depth > 0.04
+    under = scene.camera.from_world(deepest)[:2] - scene.camera.from_world(origin)[:2]
+    centre = scene.camera.from_world(scene.object_com())[:2]
+    top = scene.camera.height - 0.12  # the can stands 12 cm tall, under the palm's deepest point
+    outcome = execute_grasp(scene, pose_matrix(*(centre - under), 0.0, top), top)
+    palm_height = scene.camera.height - outcome.palm_depth
+    assert palm_height - inspire.palm_depth >= 0.12 + Execution().palm_clearance - 1e-6
+    assert outcome.cause != STRUCK
+
+
+def _corners(scene, g) -> np.ndarray:
+    m, d = scene.model, scene.data
+    unit = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
+    return (m.geom_aabb[g, :3] + unit * m.geom_aabb[g, 3:]) @ d.geom_xmat[g].reshape(3, 3).T + d.geom_xpos[g]

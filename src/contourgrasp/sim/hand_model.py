@@ -238,6 +238,9 @@ class HandModel:
     tip_depth: float
     palm_box: tuple[tuple[float, float], tuple[float, float]]
 
+    #: Nothing of this hand's palm lies below its underside, z = 0 (a mounted model's palm may: ``MountedHand``).
+    palm_depth = 0.0
+
     @property
     def open_tip_depth(self) -> float:
         """Depth of the open hand's lowest fingertip centre below the palm's underside, m."""

@@ -219,6 +219,10 @@ class Mount:
         finger's index.
     tip_depth : float
         The fingertips' largest depth below the palm's underside while closing, m.
+    palm_depth : float
+        The depth below z = 0 of the palm's deepest collision geom (0 where the palm lies above
+        z = 0), m. z = 0 is no deeper than the shallowest knuckle, so a palm reaching along the
+        fingers (the Inspire's, 61 mm read ``level``) lies partly below it.
     """
 
     palm: str
@@ -230,6 +234,7 @@ class Mount:
     held: tuple[tuple[str, float], ...]
     finger_bodies: tuple[tuple[str, int], ...]
     tip_depth: float
+    palm_depth: float = 0.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -366,7 +371,8 @@ def close_model(spec: ModelSpec, *, close_time: float = 1.0, hold_time: float = 
     mount = Mount(palm=m.body(palm).name, rotation=tuple(map(tuple, axes.tolist())), position=tuple(-shift),
                   actuators=tuple(m.actuator(a).name for a in acts), open_controls=tuple(lo.tolist()),
                   closed_controls=tuple(hi.tolist()), held=tuple((m.actuator(a).name, v) for a, v in held),
-                  finger_bodies=_finger_bodies(m, palm, tips), tip_depth=float(tips_hand[:, :, 2].max()))
+                  finger_bodies=_finger_bodies(m, palm, tips), tip_depth=float(tips_hand[:, :, 2].max()),
+                  palm_depth=0.0 if palm_geoms is None else max(0.0, float(palm_geoms[:, 2].max()) - depth))
     return ClosedModel(names=tuple(spec.names or spec.fingertips), times=m.opt.timestep * np.arange(tips_palm.shape[1]),
                        tips=tips_hand, mount=mount,
                        joints=tuple(np.transpose(j, (1, 0, 2)) @ axes.T - shift for j in joint_records),

@@ -64,6 +64,10 @@ class MountedHand:
         return self.derivation.mount.tip_depth
 
     @property
+    def palm_depth(self) -> float:
+        return self.derivation.mount.palm_depth
+
+    @property
     def open_tip_depth(self) -> float | None:
         """The derived hand file's open-tip depth (None for a 2-D file: no planned grasp height to execute)."""
         return self.hand.open_tip_depth

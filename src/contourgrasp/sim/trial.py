@@ -10,7 +10,9 @@ Execution, given the hand pose ``T_camera_hand`` and the approach depth:
    the table); otherwise until the fingertips are just above the table, but
    never bringing the palm closer than :attr:`Execution.palm_clearance` to
    ``approach_depth`` (so tall objects are grasped lower down the fingers, not
-   crushed by the palm) -- the part the thesis's operator did by hand;
+   crushed by the palm) -- the part the thesis's operator did by hand. The
+   palm's lowest point counts: a mounted model's palm may reach ``palm_depth``
+   below the hand frame's z = 0 (the Inspire's, along its fingers);
 3. the tendon force ramps to its maximum over :attr:`Execution.close_time`,
    then squeezes for :attr:`Execution.squeeze_time`;
 4. the hand lifts :attr:`Execution.lift_height` and holds for
@@ -297,7 +299,7 @@ def execute_grasp(scene: Scene, transform, approach_depth: float, execution: Exe
     top = scene.camera.height - float(approach_depth)  # the planner's idea of the object's top, world z
     if grasp_height is None:
         lowest = max(f.radius for f in scene.hand.fingers) + execution.tip_clearance
-        palm_final = max(scene.hand.tip_depth + lowest, top + execution.palm_clearance)
+        palm_final = max(scene.hand.tip_depth + lowest, top + execution.palm_clearance + scene.hand.palm_depth)
     else:
         depth = scene.hand.open_tip_depth
         if depth is None:
