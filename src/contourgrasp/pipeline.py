@@ -263,7 +263,7 @@ def _balanced_on_section(plan, section, hand: Hand, descent, height: float, opti
     if section is None:
         return plan
     try:
-        sliced = search(section, hand, descent=descent, **options)
+        sliced = search(section, hand, descent=descent, balance_required=True, **options)
     except NoFeasibleGrasp:
         return plan
     if not sliced.balanced:

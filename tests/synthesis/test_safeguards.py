@@ -141,6 +141,19 @@ def test_without_a_balanced_pose_the_plan_is_the_unbalanced_best_and_says_so():
                           "friction",)
 
 
+def test_a_required_balance_is_no_grasp_where_no_pose_balances_and_the_same_plan_where_one_does():
+    contour, hand = cg.example_contour("case"), cg.load_hand("five-finger-linear")
+    with pytest.raises(NoFeasibleGrasp, match="balances the squeeze") as refused:
+        cg.synthesize(contour, hand, require_closure=True, max_imbalance=0.25, balance_required=True, **FAST)
+    assert "without the squeeze's balance" not in str(refused.value)  # no fallback was searched
+    two = dataclasses.replace(hand, min_touching=2)
+    preferred = cg.synthesize(contour, two, require_closure=True, max_imbalance=0.25, **FAST)
+    required = cg.synthesize(contour, two, require_closure=True, max_imbalance=0.25, balance_required=True, **FAST)
+    np.testing.assert_array_equal(required.pose, preferred.pose)
+    with pytest.raises(InputError, match="balance_required"):
+        cg.synthesize(contour, two, balance_required="yes", **FAST)
+
+
 def test_the_no_grasp_reason_names_the_squeeze():
     from contourgrasp.synthesis.evaluate import evaluate_poses
     from contourgrasp.synthesis.outer import _diagnose_exact

@@ -63,13 +63,10 @@ from ..errors import PerceptionError
 from ..tolerances import (HEIGHT_MAP_CELL, HEIGHT_MAP_MARGIN, HEIGHT_MAP_OBJECT_BAND, MAX_HEIGHT_MAP_CELL, MAX_HEIGHT_MAP_CELLS,
                           MAX_HEIGHT_MAP_MARGIN, MIN_HEIGHT, SENSOR_RANGE)
 from ._pixels import dilate
+from ._shadow_kernels import shadow_bounds
 from .camera import Intrinsics, as_depth, check_intrinsics, denoised_at, pixel_points_at, valid_depth
 from .metric import MetricContour
 from .table import Plane, heights as plane_heights
-
-#: Cells of unseen columns :meth:`HeightMap.conservative` walks toward the camera at once (bounds its arrays).
-_WALK_BATCH = 4096
-
 
 @dataclass(frozen=True, eq=False)
 class HeightMap:
@@ -238,24 +235,10 @@ class HeightMap:
         reach = np.minimum(r, max(top, 0.0) * r / self.camera_height + 2 * diagonal)
         span = min(float(np.hypot(*self.shape)) * self.cell, float(reach.max()))
         steps = np.arange(1, int(math.ceil(2 * span / self.cell)) + 1) * (0.5 * self.cell)  # half cells: no cell skipped
-        bound = np.empty(len(rows))
-        ny, nx = self.shape
-        for a in range(0, len(rows), _WALK_BATCH):
-            sl = slice(a, a + _WALK_BATCH)
-            s = np.minimum(steps[None, :], reach[sl, None])
-            # The cells of the walk's points (finite, so cell_index's NaN handling is not needed here).
-            col = np.floor((start[sl, None, 0] + s * unit[sl, None, 0] - self.origin[0]) / self.cell)
-            row = np.floor((start[sl, None, 1] + s * unit[sl, None, 1] - self.origin[1]) / self.cell)
-            inside = (col >= 0) & (col < nx) & (row >= 0) & (row < ny)
-            h = np.where(inside, self.heights[np.clip(row, 0, ny - 1).astype(np.intp),
-                                              np.clip(col, 0, nx - 1).astype(np.intp)], np.nan)
-            # The occluder's point and the cell's surface may lie anywhere in their cells: the bound takes
-            # them a cell's diagonal nearer each other (which only raises it).
-            gap = np.maximum(s - diagonal, 0.0)
-            with np.errstate(invalid="ignore", divide="ignore"):
-                b = h - (self.camera_height - h) * gap / (r[sl, None] - s + 0.5 * diagonal)
-            b[~np.isfinite(b) | (s >= r[sl, None])] = -np.inf
-            bound[sl] = b.max(axis=1)
+        # The occluder's point and the cell's surface may lie anywhere in their cells: the bound takes
+        # them a cell's diagonal nearer each other (which only raises it).
+        bound = shadow_bounds(self.heights, start, unit, r, reach, steps, np.asarray(self.origin, dtype=float),
+                              float(self.cell), float(self.camera_height), diagonal, top)
         out[rows, cols] = np.where(bound > -MIN_HEIGHT, np.maximum(bound, 0.0), top)
         return out
 

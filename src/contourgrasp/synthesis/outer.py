@@ -63,6 +63,7 @@ def search(
     require_closure: bool = False,
     quality_gain: float = 0.0,
     max_imbalance: float | Literal["hand"] = 1.0,
+    balance_required: bool = False,
     small_objects: bool = False,
     descent: Descent | None = None,
 ) -> GraspPlan:
@@ -101,6 +102,10 @@ def search(
         ``"hand"``: the hand's own, :attr:`Hand.max_imbalance` (what its fingers' drive can hold).
         A balanced squeeze is preferred, not required: when no pose meets it (with the small-object
         rule's fewer fingers too), the search is repeated without it, and the plan's notes say so.
+    balance_required : bool
+        Required instead: no pose balanced within ``max_imbalance`` is no feasible grasp (how
+        :func:`contourgrasp.pipeline.plan_frame` searches the cross-section, whose plan it takes only
+        when balanced).
     small_objects : bool
         The small-object rule: when no pose satisfies the constraints with the hand's
         ``min_touching`` fingers, search again with fewer touching fingers, down to
@@ -165,10 +170,11 @@ def search(
 
     clock = time.perf_counter()
     small_objects = check.flag("small_objects", small_objects, error=PlannerError)
+    preferred = not check.flag("balance_required", balance_required, error=PlannerError)
     contour = efd_model.clean_polygon(contour_xy)
     outline = partial(_search_outline, hand=hand, grid=grid, safeguards=safeguards, descent=descent,
                       harmonics=harmonics, curvature=curvature, small_objects=small_objects, top_k=top_k,
-                      refine=refine, clock=clock)
+                      refine=refine, clock=clock, fallback=preferred)
     try:
         return outline(contour)
     except _OutOfReach as points:
@@ -187,10 +193,11 @@ def search(
 
 
 def _search_outline(contour, *, hand: Hand, grid: SearchGrid, safeguards: Safeguards, descent: Descent | None,
-                    harmonics, curvature, small_objects: bool, top_k: int, refine: bool, clock: float) -> GraspPlan:
+                    harmonics, curvature, small_objects: bool, top_k: int, refine: bool, clock: float,
+                    fallback: bool = True) -> GraspPlan:
     """:func:`search` on one cleaned outline: fit, screen, then each attempt of the small-object rule and the
-    squeeze's balance in turn. Raises :class:`_OutOfReach` when, with the fewest touching fingers tried, no
-    pose brings them onto the object within their travel."""
+    squeeze's balance in turn (``fallback``: then without the balance). Raises :class:`_OutOfReach` when, with
+    the fewest touching fingers tried, no pose brings them onto the object within their travel."""
     if harmonics == "adaptive":
         harmonics = efd_model.choose_harmonics(contour, validate=False)
     model = efd_model.fit(contour, harmonics, validate=False)
@@ -199,14 +206,15 @@ def _search_outline(contour, *, hand: Hand, grid: SearchGrid, safeguards: Safegu
     fewest = min(fewest, hand.min_touching) if small_objects else hand.min_touching
     counts = range(hand.min_touching, fewest - 1, -1)
     attempts = [(touching, safeguards) for touching in counts]
-    if safeguards.balances:  # a balanced squeeze is preferred, not required: then the thesis's best pose
+    if safeguards.balances and fallback:  # a balanced squeeze is preferred, not required: then the thesis's best pose
         attempts += [(touching, replace(safeguards, max_imbalance=1.0)) for touching in counts]
     screen = screen_grid(model, replace(hand, min_touching=fewest), grid, curvature=curvature)
+    touch_counts = np.count_nonzero(screen.touching, axis=1)
     searched = time.perf_counter()
     errors = []
     for touching, guards in attempts:
         try:
-            plan = _search_fitted(model, contour, replace(hand, min_touching=touching), _needing(screen, touching),
+            plan = _search_fitted(model, contour, replace(hand, min_touching=touching), _needing(screen, touch_counts, touching),
                                   grid, guards, descent, curvature=curvature, top_k=top_k, refine=refine,
                                   times=(clock, fitted, searched))
         except NoFeasibleGrasp as err:
@@ -253,13 +261,13 @@ def _no_grasp(errors: list[NoFeasibleGrasp], counts: int, fewest: int) -> str:
     return message
 
 
-def _needing(screen: PoseEvaluation, touching: int) -> PoseEvaluation:
+def _needing(screen: PoseEvaluation, counts: np.ndarray, touching: int) -> PoseEvaluation:
     """The screen of the fewest touching fingers, feasible only where at least ``touching`` fingers touch.
 
     Nothing else in the screen depends on ``min_touching``: one screen serves every count the
-    small-object rule tries.
+    small-object rule tries. ``counts``: the touching fingers per pose, counted once per screen.
     """
-    enough = screen.touching.sum(axis=1) >= touching
+    enough = counts >= touching
     return replace(screen, reaches=screen.reaches & enough, feasible=screen.feasible & enough)
 
 
