@@ -91,6 +91,14 @@ class _PlannerSchema(BaseModel):
     grasp_height: (Literal["clearance", "auto"]
                    | Annotated[float, Field(ge=0, le=tol.MAX_HAND_SIZE, allow_inf_nan=False)] | None) = None
 
+    @field_validator("slice_contour", mode="before")
+    @classmethod
+    def _slice(cls, value):
+        """Name the three values, rather than only the first the union tried (a boolean)."""
+        if not isinstance(value, bool) and value != "unbalanced":
+            raise ValueError(f'must be true, false or "unbalanced", got {value!r}')
+        return value
+
     @field_validator("grasp_height", mode="before")
     @classmethod
     def _height(cls, value):
@@ -189,4 +197,4 @@ def _describe(err: ValidationError) -> str:
         return f"{field}: unknown key"
     if first["type"] == "missing":
         return f"{field}: required field is missing"
-    return f"{field}: {first['msg']}"
+    return f"{field}: {first['msg'].removeprefix('Value error, ')}"
