@@ -68,6 +68,7 @@ from .camera import Intrinsics, as_depth, check_intrinsics, denoised_at, pixel_p
 from .metric import MetricContour
 from .table import Plane, heights as plane_heights
 
+
 @dataclass(frozen=True, eq=False)
 class HeightMap:
     """Heights above the table on a regular grid in the planning frame.

@@ -222,7 +222,7 @@ class Mount:
     palm_depth : float
         The depth below z = 0 of the palm's deepest collision geom (0 where the palm lies above
         z = 0), m. z = 0 is no deeper than the shallowest knuckle, so a palm reaching along the
-        fingers (the Inspire's, 61 mm read ``level``) lies partly below it.
+        fingers (the Inspire's, read ``level``) lies partly below it.
     """
 
     palm: str

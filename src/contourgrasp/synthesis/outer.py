@@ -214,9 +214,9 @@ def _search_outline(contour, *, hand: Hand, grid: SearchGrid, safeguards: Safegu
     errors = []
     for touching, guards in attempts:
         try:
-            plan = _search_fitted(model, contour, replace(hand, min_touching=touching), _needing(screen, touch_counts, touching),
-                                  grid, guards, descent, curvature=curvature, top_k=top_k, refine=refine,
-                                  times=(clock, fitted, searched))
+            plan = _search_fitted(model, contour, replace(hand, min_touching=touching),
+                                  _needing(screen, touch_counts, touching), grid, guards, descent,
+                                  curvature=curvature, top_k=top_k, refine=refine, times=(clock, fitted, searched))
         except NoFeasibleGrasp as err:
             errors.append(err)  # its reason worked out only if every attempt fails (_Unexplained)
             continue
