@@ -259,14 +259,13 @@ NOTE_SECTION = ("no pose balances the squeeze on the outline seen: planned on th
 
 
 def _balanced_on_section(plan, section, hand: Hand, descent, height: float, options):
-    """The plan on ``section`` if a pose balances the squeeze there, else ``plan`` (the outline seen's)."""
+    """The plan on ``section`` if a pose balances the squeeze there (the search requires it), else ``plan``
+    (the outline seen's)."""
     if section is None:
         return plan
     try:
         sliced = search(section, hand, descent=descent, balance_required=True, **options)
     except NoFeasibleGrasp:
-        return plan
-    if not sliced.balanced:
         return plan
     return replace(sliced, search_notes=sliced.search_notes + (NOTE_SECTION.format(height=1000 * height),))
 

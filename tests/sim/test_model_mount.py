@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from contourgrasp.sim.model_hand import MODELS
+from contourgrasp.sim.model_hand import MODELS, _geom_corners
 from contourgrasp.sim.model_mount import PREFIX, mount_model
 from contourgrasp.sim.objects import soda_can
 from contourgrasp.sim.planners import make_planner
@@ -55,8 +55,8 @@ def test_the_inspire_palm_below_its_frame_is_kept_clear_of_a_tall_object():
     scene.set_hand(0.0, 0.0, 0.6, 0.0)
     scene.step(0.01)
     origin = scene.palm_pose()[0]
-    corners = np.concatenate([_corners(scene, scene.model.geom(name).id) for name in inspire.geom_names()
-                              if name.startswith("palm_")])
+    palm = [scene.model.geom(name).id for name in inspire.geom_names() if name.startswith("palm_")]
+    corners = _geom_corners(scene.model, scene.data, palm, np.zeros(3), np.eye(3))  # world frame
     deepest = corners[np.argmin(corners[:, 2])]
     assert origin[2] - deepest[2] == pytest.approx(inspire.palm_depth, abs=2e-3) and inspire.palm_depth > 0.04
     under = scene.camera.from_world(deepest)[:2] - scene.camera.from_world(origin)[:2]
@@ -67,8 +67,3 @@ def test_the_inspire_palm_below_its_frame_is_kept_clear_of_a_tall_object():
     assert palm_height - inspire.palm_depth >= 0.12 + Execution().palm_clearance - 1e-6
     assert outcome.cause != STRUCK
 
-
-def _corners(scene, g) -> np.ndarray:
-    m, d = scene.model, scene.data
-    unit = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
-    return (m.geom_aabb[g, :3] + unit * m.geom_aabb[g, 3:]) @ d.geom_xmat[g].reshape(3, 3).T + d.geom_xpos[g]
