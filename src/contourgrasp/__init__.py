@@ -29,7 +29,7 @@ _LAZY = {
     "efd": (".efd", None), "hand": (".hand", None), "synthesis": (".synthesis", None),
     "validation": (".validation", None), "EFD": (".contour", "EFD"), "GraspPlan": (".synthesis", "GraspPlan"),
     "Arc": (".hand", "Arc"), "Finger": (".hand", "Finger"), "Hand": (".hand", "Hand"), "Ray": (".hand", "Ray"),
-    "FingerChain": (".hand", "FingerChain"), "Palm": (".hand", "Palm"),
+    "FingerChain": (".hand", "FingerChain"), "Palm": (".hand", "Palm"), "SampledChain": (".hand", "SampledChain"),
     "example_contour": (".io.contour_file", "example_contour"), "example_names": (".io.contour_file", "example_names"),
     "read_contour": (".io.contour_file", "read_contour"), "load_hand": (".io.hand_file", "load_hand"),
     "preset_names": (".io.hand_file", "preset_names"), "load_planner": (".io.planner_file", "load_planner"),
@@ -110,7 +110,7 @@ def plan_grasp(rgb, depth, intrinsics, hand="five-finger-linear", *, planner=Non
 
 __all__ = [
     "Arc", "ContourError", "EFD", "Finger", "FingerChain", "GraspPlan", "Hand", "HandFileError", "InputError",
-    "NoFeasibleGrasp", "Palm", "Ray", "UnitWarning", "efd", "example_contour", "example_names", "hand",
+    "NoFeasibleGrasp", "Palm", "Ray", "SampledChain", "UnitWarning", "efd", "example_contour", "example_names", "hand",
     "load_hand", "load_planner", "plan_grasp", "planner_names", "preset_names", "read_contour", "synthesis",
     "synthesize",
 ]

@@ -332,6 +332,20 @@ MAX_FINGERS = 10
 #: end, and the projected tip path within it of the trajectory all along (hand.check_chain).
 CHAIN_TRAJECTORY = 1e-3
 
+#: A palm's underside given by its vertices' depths must be planar to this (m): the descent check takes
+#: the plane through them.
+PALM_PLANARITY = 1e-4
+
+#: Most samples (closing progresses) of a hand.SampledChain, and most points per sample (knuckle, further
+#: joints, tip): a measured chain is checked and swept sample by sample, so its size bounds the work.
+MAX_CHAIN_SAMPLES = 201
+MAX_CHAIN_POINTS = 8
+
+#: Samples of a chain measured on a hand model (sim.model_hand): evenly in the tip's travel, close
+#: enough that the linear interpolation between them stays within a few hundredths of a millimetre
+#: of the arcs the bundled models' tips follow.
+MODEL_CHAIN_SAMPLES = 41
+
 #: Closing progresses s in [0, 1] at which hand.check_chain compares a chain's tip with its 2-D path.
 CHAIN_SAMPLES = 201
 

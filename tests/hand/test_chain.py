@@ -11,11 +11,13 @@ from contourgrasp.errors import HandError
 from contourgrasp.hand import (
     FingerChain,
     Palm,
+    SampledChain,
     chain_capsules,
     chain_deviation,
     chain_joints,
     chain_tip,
     check_chain,
+    link_names,
 )
 
 
@@ -166,3 +168,66 @@ def test_chain_and_palm_values_are_checked():
         replace(hand, chains=hand.chains[:4])
     with pytest.raises(HandError, match="radius"):
         replace(hand, chains=(replace(hand.chains[0], radius=0.02), *hand.chains[1:]))
+
+
+def sampled_from(chain, m=41):
+    """The planar chain's joints measured at m evenly spaced closing progresses, as a SampledChain."""
+    return SampledChain(joints=chain_joints(chain, np.linspace(0.0, 1.0, m)), radius=chain.radius)
+
+
+def test_a_sampled_chain_is_its_samples_and_linear_between_them():
+    planar = straight_chain(tilt=0.3, q=(0.2, 0.5))
+    sampled = sampled_from(planar, m=5)
+    at = np.array([0.0, 0.25, 0.5, 1.0])
+    np.testing.assert_allclose(chain_joints(sampled, at), chain_joints(planar, at), atol=1e-15)
+    halfway = chain_joints(sampled, 0.125)[0]
+    np.testing.assert_allclose(halfway, chain_joints(planar, [0.0, 0.25]).mean(axis=0), atol=1e-15)
+    np.testing.assert_allclose(chain_joints(sampled, [-1.0, 2.0]), chain_joints(planar, [0.0, 1.0]), atol=1e-15)
+    np.testing.assert_allclose(chain_capsules(sampled, at), chain_capsules(planar, at), atol=1e-15)
+    assert link_names(planar) == link_names(sampled) == ("post", "proximal", "distal")
+
+
+def test_a_sampled_chain_of_four_hinges_is_a_post_and_four_links():
+    joints = [[[0.0, 0.0, 0.01 * k] for k in range(5)], [[0.0, 0.002 * k, 0.01 * k] for k in range(5)]]
+    chain = SampledChain(joints=joints, radius=0.005)
+    capsules = chain_capsules(chain, 1.0)[0]
+    assert capsules.shape == (5, 2, 3) and link_names(chain) == ("post", "link 1", "link 2", "link 3", "link 4")
+    np.testing.assert_allclose(capsules[0], [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0]])  # the knuckle is on the palm
+    np.testing.assert_allclose(chain_tip(chain, 1.0)[0], [0.0, 0.008, 0.04])
+
+
+def test_a_sampled_chain_is_checked_against_its_trajectory_within_the_fit_tolerance():
+    planar = straight_chain()
+    tip = chain_tip(planar, [0.0, 1.0])[:, :2]
+    finger = Finger(name="index", start=tuple(tip[0]), trajectory=Ray((0.0, -1.0)), travel=0.03, radius=0.008)
+    line = np.c_[np.full(41, tip[0, 0]), tip[0, 1] - np.linspace(0, 0.03, 41), np.full(41, 0.1)]
+    knuckle = np.tile([tip[0, 0], tip[0, 1] + 0.05, 0.0], (41, 1))
+    bowed = line + np.c_[0.0025 * np.sin(np.linspace(0, np.pi, 41)), np.zeros((41, 2))]  # 2.5 mm off the ray
+    check_chain(finger, SampledChain(joints=np.stack([knuckle, bowed], axis=1), radius=0.008))  # within 3 mm
+    too_far = line + np.c_[0.0035 * np.sin(np.linspace(0, np.pi, 41)), np.zeros((41, 2))]
+    with pytest.raises(HandError, match=r"finger 'index': 3-D chain: tip path leaves the finger's ray by 3.50 mm"):
+        check_chain(finger, SampledChain(joints=np.stack([knuckle, too_far], axis=1), radius=0.008))
+
+
+def test_sampled_chain_values_are_checked():
+    with pytest.raises(HandError, match="2..201 samples of 2..8"):
+        SampledChain(joints=[[[0, 0, 0.01], [0, 0, 0.05]]], radius=0.005)
+    with pytest.raises(HandError, match="2..201 samples of 2..8"):
+        SampledChain(joints=np.zeros((2, 9, 3)), radius=0.005)
+    with pytest.raises(HandError, match="finite"):
+        SampledChain(joints=[[[0, 0, np.nan], [0, 0, 0.05]]] * 2, radius=0.005)
+    with pytest.raises(HandError, match="joints"):
+        SampledChain(joints=[[[0, 0, 3.0], [0, 0, 0.05]]] * 2, radius=0.005)
+    with pytest.raises(HandError, match="radius"):
+        SampledChain(joints=[[[0, 0, 0.01], [0, 0, 0.05]]] * 2, radius=-0.005)
+
+
+def test_a_tilted_palm_is_the_plane_through_its_vertices():
+    palm = Palm(outline=((0, 0, 0.01), (0.1, 0, 0.03), (0.1, 0.1, 0.05), (0, 0.1, 0.03)), thickness=0.02)
+    np.testing.assert_allclose(palm.plane, [0.01, 0.2, 0.2], atol=1e-15)
+    assert palm.outline == ((0, 0), (0.1, 0), (0.1, 0.1), (0, 0.1)) and palm.depths == (0.01, 0.03, 0.05, 0.03)
+    assert Palm(outline=((0, 0, 0), (0.1, 0, 0), (0.1, 0.1, 0)), thickness=0.02).depths is None  # flat at z = 0
+    with pytest.raises(HandError, match="0.50 mm off one plane"):
+        Palm(outline=((0, 0), (0.1, 0), (0.1, 0.1), (0, 0.1)), thickness=0.02, depths=(0, 0, 0, 0.002))
+    with pytest.raises(HandError, match="one finite number per outline vertex"):
+        Palm(outline=((0, 0), (0.1, 0), (0.1, 0.1)), thickness=0.02, depths=(0, 0))

@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 
 import contourgrasp as cg
 from contourgrasp import HandFileError
-from contourgrasp.hand import Finger, Hand, Ray
+from contourgrasp.hand import Finger, FingerChain, Hand, Ray, SampledChain, chain_joints, chain_tip
 from contourgrasp.io.hand_file import hand_to_toml, load_hand, parse_hand, preset_names
 
 GOOD = """
@@ -229,6 +229,47 @@ def test_3d_hand_file_errors_name_the_file_and_the_field(tmp_path, old, new, mes
     path.write_text(PINCH_3D.replace(old, new, 1))
     with pytest.raises(HandFileError, match=re.escape(str(path)) + ": " + message):
         load_hand(path)
+
+
+def measured_pinch():
+    """PINCH_3D with its left finger's chain as measured (joints) and its palm tilted (vertices with z)."""
+    planar = parse_hand(PINCH_3D)
+    joints = chain_joints(planar.chains[0], np.linspace(0.0, 1.0, 5)).round(6).tolist()
+    left = PINCH_3D[PINCH_3D.index("[fingers.chain]"):PINCH_3D.index("[[fingers]]", PINCH_3D.index("[fingers.chain]"))]
+    text = PINCH_3D.replace(left, f"[fingers.chain]\njoints = {joints}\n", 1)
+    return text.replace("outline = [[-0.08, -0.02], [0.08, -0.02], [0.08, 0.02], [-0.08, 0.02]]",
+                        "outline = [[-0.08, -0.02, 0.0], [0.08, -0.02, 0.016], [0.08, 0.02, 0.016], [-0.08, 0.02, 0.0]]")
+
+
+def test_a_measured_chain_and_a_tilted_palm_load_and_round_trip():
+    hand = parse_hand(measured_pinch())
+    assert isinstance(hand.chains[0], SampledChain) and isinstance(hand.chains[1], FingerChain)
+    np.testing.assert_allclose(chain_tip(hand.chains[0], [0.0, 0.5, 1.0]),
+                               chain_tip(parse_hand(PINCH_3D).chains[0], [0.0, 0.5, 1.0]), atol=1e-6)
+    np.testing.assert_allclose(hand.palm.plane, [0.008, 0.1, 0.0], atol=1e-12)
+    assert parse_hand(hand_to_toml(hand)) == hand
+
+
+@pytest.mark.parametrize(
+    "old, new, message",
+    [
+        ("joints = ", "knuckle = [-0.06, 0.0]\njoints = ",
+         r"fingers\[0\] \(left\)\.chain: give either joints \(a measured chain\) or the planar chain's keys, not both"),
+        ("joints = [[", "joints = [[[0.0, 0.0, 0.0], ", r"fingers\[0\] \(left\)\.chain: every sample of joints must have"),
+        ("joints = [[", "joints = [[[0.0, 0.0]], [", r"fingers\[0\] \(left\)\.chain\.joints\[0\]\[0\]: List should have at least 3"),
+        ("0.016], [0.08, 0.02, 0.016]", "0.016], [0.08, 0.02, 0.026]", r"palm: palm: the outline's vertices are 2\.50 mm off one plane"),
+    ],
+)
+def test_measured_chain_and_tilted_palm_errors_name_the_field(old, new, message):
+    text = measured_pinch()
+    assert old in text
+    with pytest.raises(HandFileError, match=r"<string>: " + message):
+        parse_hand(text.replace(old, new, 1))
+
+
+def test_a_planar_chain_missing_a_key_says_which():
+    with pytest.raises(HandFileError, match=r"fingers\[0\] \(left\)\.chain: a planar chain needs .*missing: links"):
+        parse_hand(PINCH_3D.replace("links = [0.05, 0.05]\n", "", 1))
 
 
 def test_a_3d_hand_needs_every_chain_and_the_palm():

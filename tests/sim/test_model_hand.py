@@ -5,7 +5,7 @@ import pytest
 
 from contourgrasp import tolerances as tol
 from contourgrasp.errors import HandError, HandFileError
-from contourgrasp.hand import Ray
+from contourgrasp.hand import Ray, SampledChain, chain_joints, chain_tip
 from contourgrasp.io.hand_file import hand_to_toml, load_hand, parse_hand
 from contourgrasp.sim.hand_model import build_hand
 from contourgrasp.sim.model_hand import MODELS, derive_hand
@@ -116,6 +116,29 @@ def test_bundled_models_derive_hands_within_the_tolerance(name, fingers):
     ends = derived.hand.ends
     assert np.linalg.norm(ends - ends.mean(axis=0), axis=1).mean() < np.linalg.norm(
         derived.hand.starts - derived.hand.starts.mean(axis=0), axis=1).mean()  # closing brings the tips together
+
+
+@pytest.mark.parametrize("name, hinges", [("inspire", [4, 2, 2, 2, 2]), ("jaco-three-finger", [2, 2, 2])])
+def test_bundled_models_carry_their_chains_as_measured(name, hinges):
+    derived = derive_hand(name)
+    hand = derived.hand
+    assert hand.is_3d and not derived.notes and all(isinstance(c, SampledChain) for c in hand.chains)
+    assert [chain_joints(c, 0.0).shape[1] - 1 for c in hand.chains] == hinges  # a point per hinge, and the tip
+    for finger, chain in zip(hand.fingers, hand.chains, strict=True):
+        assert chain.radius == finger.radius
+        np.testing.assert_allclose(chain_tip(chain, 0.0)[0, :2], finger.start, atol=1e-6)  # sampled from the open tip
+    mount = derived.mount
+    assert max(chain_tip(c, np.linspace(0, 1, 101))[:, 2].max() for c in hand.chains) == pytest.approx(
+        mount.tip_depth, abs=5e-4)  # the measured tips go as deep as the model's
+    assert max(hand.palm.depths or (0.0,)) == pytest.approx(mount.palm_depth, abs=1e-9)  # the palm box's deepest corner
+    assert parse_hand(hand_to_toml(hand)) == hand
+
+
+def test_the_inspire_palm_is_its_box_tilted_underside():
+    palm = derive_hand("inspire").hand.palm
+    a, b, c = palm.plane
+    assert b > 0.9 and abs(c) < 0.1  # read level, the palm slopes down toward the fingers (about 48 degrees)
+    assert min(palm.depths) < -0.02 and max(palm.depths) > 0.05
 
 
 def test_a_derived_hand_carries_the_models_squeeze_balance(sliders):

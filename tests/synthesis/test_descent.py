@@ -8,7 +8,7 @@ import pytest
 
 from contourgrasp import load_hand
 from contourgrasp.errors import HandError, NoFeasibleGrasp, PerceptionError, PlannerError
-from contourgrasp.hand import Hand, chain_tip
+from contourgrasp.hand import Hand, SampledChain, chain_joints, chain_tip
 from contourgrasp.perception import HeightMap
 from contourgrasp.synthesis.descent import (Descent, body_names, check_candidates, descent_clearance, descent_feasible,
                                             descent_floor)
@@ -197,6 +197,29 @@ def test_the_palm_strikes_a_tall_object_beneath_it(hand):
     assert body_names(hand)[check.blocking[0]] == "palm"
     palm_height = TIP + chain_tip(hand.chains[2], 0.0)[0][2]  # every tip is as deep; palm underside above them
     assert check.clearance[0, -1] == pytest.approx(palm_height - 0.2, abs=1e-9)
+
+
+def test_a_tilted_palm_strikes_where_its_underside_is_deepest(hand):
+    # the palm's underside tilted down toward +x by 0.5 m/m: over a post one cell wide at (x, 0.14) (a column of
+    # cell centres) its lowest point is z = 0.5 x deeper than the flat palm's, so the clearance drops by exactly that
+    palm = hand.palm
+    tilted = replace(hand, palm=replace(palm, depths=tuple(0.5 * x for x, _ in palm.outline)))
+    for x in (-0.021, 0.001, 0.031):
+        post = scene(lambda gx, gy, x=x: np.where((np.abs(gx - x) < 1e-4) & (np.abs(gy - 0.14) < 0.003), 0.2, 0.0))
+        flat = descent_clearance(hand, post, [[0.0, 0.0, 0.0]], TIP)[0, -1]
+        lowered = descent_clearance(tilted, post, [[0.0, 0.0, 0.0]], TIP)[0, -1]
+        assert lowered - flat == pytest.approx(-0.5 * x, abs=1e-9)
+
+
+def test_a_hand_of_sampled_chains_descends_as_its_planar_chains(hand):
+    sampled = replace(hand, chains=tuple(SampledChain(joints=chain_joints(c, np.linspace(0, 1, 21)), radius=c.radius)
+                                         for c in hand.chains))
+    wall = scene(lambda x, y: np.where(y > 0.1, 0.12, 0.0))
+    rng = np.random.default_rng(3)
+    poses = np.c_[rng.uniform(-0.05, 0.05, (50, 2)), rng.uniform(0, 2 * np.pi, 50)]
+    np.testing.assert_allclose(descent_clearance(sampled, wall, poses, TIP), descent_clearance(hand, wall, poses, TIP),
+                               atol=1e-12)
+    assert body_names(sampled) == body_names(hand)
 
 
 def test_bad_arguments_are_refused_by_name(hand):

@@ -19,12 +19,14 @@ from ..errors import HandError
 from .chain import (
     FingerChain,
     Palm,
+    SampledChain,
     chain_angles,
     chain_capsules,
     chain_deviation,
     chain_joints,
     chain_tip,
     check_chain,
+    link_names,
 )
 from .trajectory import (
     Arc,
@@ -36,9 +38,9 @@ from .trajectory import (
     trajectory_polyline,
 )
 
-__all__ = ["Arc", "Finger", "FingerChain", "Hand", "HandSegments", "Palm", "Ray", "chain_angles", "chain_capsules",
-           "chain_deviation", "chain_joints", "chain_tip", "check_chain", "polyline_distance", "rotation",
-           "to_image", "trajectory_polyline"]
+__all__ = ["Arc", "Finger", "FingerChain", "Hand", "HandSegments", "Palm", "Ray", "SampledChain", "chain_angles",
+           "chain_capsules", "chain_deviation", "chain_joints", "chain_tip", "check_chain", "link_names",
+           "polyline_distance", "rotation", "to_image", "trajectory_polyline"]
 
 
 @dataclass(frozen=True)
@@ -61,7 +63,7 @@ class Hand:
         holding their own positions stop the object against the others. Default
         ``tolerances.HAND_MAX_IMBALANCE``.
     description : str
-    chains : tuple of FingerChain, optional
+    chains : tuple of FingerChain or SampledChain, optional
         The fingers' bodies, one per finger in the order of ``fingers``; None (the default) for a
         2-D hand. Given together with ``palm``.
     palm : Palm, optional
@@ -82,7 +84,7 @@ class Hand:
     miss_penalty: float = 250.0
     max_imbalance: float = tol.HAND_MAX_IMBALANCE
     description: str = field(default="", compare=False)
-    chains: tuple[FingerChain, ...] | None = None
+    chains: tuple[FingerChain | SampledChain, ...] | None = None
     palm: Palm | None = None
 
     def __post_init__(self):
@@ -112,8 +114,9 @@ class Hand:
             return
         if not isinstance(self.palm, Palm):
             raise HandError(f"hand {self.name!r}: palm must be a Palm, got {type(self.palm).__name__}")
-        if not isinstance(self.chains, (tuple, list)) or not all(isinstance(c, FingerChain) for c in self.chains):
-            raise HandError(f"hand {self.name!r}: chains must be a sequence of FingerChain")
+        if not isinstance(self.chains, (tuple, list)) or not all(isinstance(c, (FingerChain, SampledChain))
+                                                                 for c in self.chains):
+            raise HandError(f"hand {self.name!r}: chains must be a sequence of FingerChain or SampledChain")
         object.__setattr__(self, "chains", tuple(self.chains))
         if len(self.chains) != len(self.fingers):
             raise HandError(f"hand {self.name!r}: {len(self.chains)} chains for {len(self.fingers)} fingers")
@@ -200,6 +203,6 @@ class HandSegments:
 
 
 @functools.lru_cache(maxsize=64)
-def _check_chain_once(finger: Finger, chain: FingerChain) -> None:
+def _check_chain_once(finger: Finger, chain: FingerChain | SampledChain) -> None:
     """:func:`check_chain`, remembered: the search copies its hand per attempt (``min_touching``), 1 ms each."""
     check_chain(finger, chain)

@@ -34,9 +34,13 @@ Schema (all lengths in meters, angles in radians)::
     links = [0.0668, 0.0547]         # proximal, distal > 0
     open_angles = [-0.43, 0.0]       # (q1, q2) of the open finger, rad
     closed_angles = [0.103, 0.533]   # and of the fully closed one (linear synergy between)
+    # joints = [[[x, y, z], ...], ...]   # ... or, instead of those five keys, the chain as
+                                     # measured (hand-from-model): per closing progress evenly
+                                     # in [0, 1], its points from knuckle to tip (SampledChain)
 
     [palm]                           # with the chains: every finger has one, or none does
-    outline = [[x, y], ...]          # >= 3 vertices, the palm's underside
+    outline = [[x, y], ...]          # >= 3 vertices, the palm's underside at z = 0, or
+                                     # [[x, y, z], ...] on one plane: a tilted underside
     thickness = 0.025                # > 0
 
 A 3-D part inconsistent with the 2-D one (the chain's open tip more than 1 mm from ``start``
@@ -60,7 +64,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from .. import tolerances as tol
 from ..errors import HandError, HandFileError
-from ..hand import Arc, Finger, FingerChain, Hand, Palm, Ray, check_chain
+from ..hand import Arc, Finger, FingerChain, Hand, Palm, Ray, SampledChain, check_chain
 from . import _toml_files
 
 _PRESET_DIR = "data/hands"
@@ -91,25 +95,42 @@ class _ArcSchema(_Strict):
 Angles2 = Annotated[list[Annotated[float, Field(ge=-tol.MAX_JOINT_ANGLE, le=tol.MAX_JOINT_ANGLE,
                                                  allow_inf_nan=False)]], Field(min_length=2, max_length=2)]
 Links2 = Annotated[list[Length], Field(min_length=2, max_length=2)]
+Point3 = Annotated[list[Offset], Field(min_length=3, max_length=3)]
+Samples = Annotated[list[Annotated[list[Point3], Field(min_length=2, max_length=tol.MAX_CHAIN_POINTS)]],
+                    Field(min_length=2, max_length=tol.MAX_CHAIN_SAMPLES)]
 
 
 class _ChainSchema(_Strict):
-    knuckle: Point2
-    knuckle_depth: Radius
+    knuckle: Point2 | None = None
+    knuckle_depth: Radius | None = None
     direction: Vector2 | None = None
-    links: Links2
-    open_angles: Angles2
-    closed_angles: Angles2
+    links: Links2 | None = None
+    open_angles: Angles2 | None = None
+    closed_angles: Angles2 | None = None
+    joints: Samples | None = None
 
     @model_validator(mode="after")
-    def _direction(self):
+    def _one_form(self):
+        planar = ("knuckle", "knuckle_depth", "links", "open_angles", "closed_angles")
+        given = [k for k in planar if getattr(self, k) is not None]
+        if self.joints is not None:
+            if given or self.direction is not None:
+                raise ValueError(f"give either joints (a measured chain) or the planar chain's keys, not both "
+                                 f"(got joints and {', '.join(given or ['direction'])})")
+            if len({len(sample) for sample in self.joints}) != 1:
+                raise ValueError("every sample of joints must have the same number of points")
+            return self
+        if missing := [k for k in planar if k not in given]:
+            raise ValueError(f"a planar chain needs {', '.join(planar)}; missing: {', '.join(missing)} "
+                             "(or give joints, a measured chain)")
         if self.direction is not None and max(map(abs, self.direction)) == 0:
             raise ValueError("direction has zero length")
         return self
 
 
 class _PalmSchema(_Strict):
-    outline: Annotated[list[Point2], Field(min_length=3, max_length=1000)]
+    outline: Annotated[list[Annotated[list[Offset], Field(min_length=2, max_length=3)]], Field(min_length=3,
+                                                                                               max_length=1000)]
     thickness: Length
 
 
@@ -132,7 +153,7 @@ class _FingerSchema(_Strict):
             raise ValueError("give exactly one of closing_direction (a ray) or arc")
         if self.closing_direction is not None and max(map(abs, self.closing_direction)) == 0:
             raise ValueError("closing_direction has zero length")
-        if self.chain is not None and self.chain.direction is None and self.arc is not None:
+        if self.chain is not None and self.chain.joints is None and self.chain.direction is None and self.arc is not None:
             raise ValueError("chain.direction is required for a finger on an arc")
         return self
 
@@ -212,14 +233,17 @@ def parse_hand(text: str, *, source: str = "<string>") -> Hand:
         raise HandFileError(f"{source}: {err}") from None
 
 
-def _chain(source: str, index: int, finger: Finger, f: _FingerSchema) -> FingerChain:
+def _chain(source: str, index: int, finger: Finger, f: _FingerSchema) -> FingerChain | SampledChain:
     """The chain of ``finger``, checked against its trajectory; errors name ``fingers[index] (name).chain``."""
     c = f.chain
-    direction = c.direction if c.direction is not None else finger.trajectory.closing_direction
     try:
-        chain = FingerChain(knuckle=tuple(c.knuckle), knuckle_depth=c.knuckle_depth, direction=tuple(direction),
-                            links=tuple(c.links), radius=finger.radius, open_angles=tuple(c.open_angles),
-                            closed_angles=tuple(c.closed_angles))
+        if c.joints is not None:
+            chain = SampledChain(joints=c.joints, radius=finger.radius)
+        else:
+            direction = c.direction if c.direction is not None else finger.trajectory.closing_direction
+            chain = FingerChain(knuckle=tuple(c.knuckle), knuckle_depth=c.knuckle_depth, direction=tuple(direction),
+                                links=tuple(c.links), radius=finger.radius, open_angles=tuple(c.open_angles),
+                                closed_angles=tuple(c.closed_angles))
         check_chain(finger, chain)
     except HandError as err:
         raise HandFileError(f"{source}: fingers[{index}] ({finger.name}).chain: {err}") from None
@@ -298,8 +322,12 @@ def hand_to_toml(hand: Hand, *, comment: str = "") -> str:
     return "\n".join(lines) + "\n"
 
 
-def chain_toml(chain: FingerChain, finger: Finger) -> list[str]:
-    """The lines of the ``[fingers.chain]`` table of ``chain`` (its direction only when not the ray's)."""
+def chain_toml(chain: FingerChain | SampledChain, finger: Finger) -> list[str]:
+    """The lines of the ``[fingers.chain]`` table of ``chain`` (a planar chain's direction only when not the ray's;
+    a sampled chain's joints one sample a line)."""
+    if isinstance(chain, SampledChain):
+        samples = ",\n  ".join("[" + ", ".join(_floats(p) for p in sample) + "]" for sample in chain.joints)
+        return ["", "[fingers.chain]", f"joints = [\n  {samples},\n]"]
     lines = ["", "[fingers.chain]", f"knuckle = {_floats(chain.knuckle)}",
              f"knuckle_depth = {_float(chain.knuckle_depth)}"]
     if not isinstance(finger.trajectory, Ray) or tuple(chain.direction) != finger.trajectory.closing_direction:
@@ -310,7 +338,8 @@ def chain_toml(chain: FingerChain, finger: Finger) -> list[str]:
 
 def palm_toml(palm: Palm) -> list[str]:
     """The lines of the ``[palm]`` table."""
-    outline = ", ".join(_floats(p) for p in palm.outline)
+    vertices = palm.outline if palm.depths is None else [(*p, z) for p, z in zip(palm.outline, palm.depths, strict=True)]
+    outline = ", ".join(_floats(p) for p in vertices)
     return ["", "[palm]", f"outline = [{outline}]", f"thickness = {_float(palm.thickness)}"]
 
 

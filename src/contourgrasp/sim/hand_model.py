@@ -359,8 +359,9 @@ def build_hand(hand: Hand, *, design: HandDesign = HandDesign(), timing: str = "
     ------
     SimulationError
         A finger closes on an arc, an unknown ``timing``, a travel no finger of the
-        :class:`ChainRule` can reach, a finger of radius 0, a joint whose closed angle is not
-        beyond its open one, or a palm that is not an axis-aligned rectangle.
+        :class:`ChainRule` can reach, a measured chain (:class:`~contourgrasp.hand.SampledChain`), a
+        finger of radius 0, a joint whose closed angle is not beyond its open one, or a palm that is
+        not an axis-aligned rectangle at z = 0.
     """
     if timing not in TIMINGS:
         raise SimulationError(f"unknown finger timing {timing!r}; choose one of {', '.join(TIMINGS)}")
@@ -374,6 +375,9 @@ def build_hand(hand: Hand, *, design: HandDesign = HandDesign(), timing: str = "
     fingers = []
     for finger, chain in zip(hand.fingers, hand.chains, strict=True):
         what = f"hand {hand.name!r}: finger {finger.name!r}"
+        if not isinstance(chain, FingerChain):
+            raise SimulationError(f"{what} has a measured chain (joints): the simulated hand is built from planar "
+                                  "chains; simulate the hand's own model instead (bench --hand-model)")
         if chain.radius <= 0:
             raise SimulationError(f"{what} has radius 0: the simulated finger needs a thickness")
         if not all(c > o for o, c in zip(chain.open_angles, chain.closed_angles, strict=True)):
@@ -395,9 +399,9 @@ def _palm_box(hand: Hand) -> tuple[tuple[float, float], tuple[float, float]]:
     pts = hand.palm.points
     lo, hi = pts.min(axis=0), pts.max(axis=0)
     corners = {(x, y) for x in (lo[0], hi[0]) for y in (lo[1], hi[1])}
-    if len(pts) != 4 or {tuple(p) for p in pts.tolist()} != corners:
+    if len(pts) != 4 or {tuple(p) for p in pts.tolist()} != corners or hand.palm.depths is not None:
         raise SimulationError(f"hand {hand.name!r}: the simulated palm is a box; its outline must be an "
-                              "axis-aligned rectangle (4 corners)")
+                              "axis-aligned rectangle (4 corners) at z = 0")
     return (float(lo[0]), float(lo[1])), (float(hi[0]), float(hi[1]))
 
 

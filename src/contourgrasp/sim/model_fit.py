@@ -4,7 +4,8 @@ Pure numpy on the paths :mod:`contourgrasp.sim.model_hand` records (its docstrin
 the model): :func:`fit_finger` fits a projected fingertip path with a ray (eq 3.18) or, when the ray
 leaves it by more than ``tolerances.MODEL_FIT_TOLERANCE``, an axis-aligned elliptic arc (eq 3.20,
 a least-squares conic); :func:`travelled` reads a path as distances along the fitted trajectory;
-:func:`fit_chain` measures a two-hinge finger's :class:`~contourgrasp.hand.FingerChain`.
+:func:`fit_chain` measures a two-hinge finger's :class:`~contourgrasp.hand.FingerChain`, and
+:func:`sampled_chain` any finger's :class:`~contourgrasp.hand.SampledChain`.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import numpy as np
 
 from .. import tolerances as tol
 from ..errors import HandError
-from ..hand import Arc, Finger, FingerChain, Ray, check_chain, polyline_distance
+from ..hand import Arc, Finger, FingerChain, Ray, SampledChain, check_chain, polyline_distance
 
 #: Default gains of a derived hand's fingers (the five-finger-linear preset's).
 ALPHA, BETA = 25.0, 10000.0
@@ -144,6 +145,34 @@ def fit_chain(finger: Finger, tips: np.ndarray, joints: np.ndarray) -> tuple[Fin
         chain = FingerChain(knuckle=tuple(knuckle[0, :2]), knuckle_depth=float(knuckle[0, 2]), direction=tuple(direction),
                             links=links, radius=finger.radius, open_angles=(float(a1[0]), float(a2[0] - a1[0])),
                             closed_angles=(float(a1[1]), float(a2[1] - a1[1])))
+        check_chain(finger, chain)
+    except HandError as err:
+        return None, str(err)
+    return chain, ""
+
+
+def sampled_chain(finger: Finger, tips: np.ndarray, joints: np.ndarray) -> tuple[SampledChain | None, str]:
+    """The finger's chain as measured, or None and why not (:func:`~contourgrasp.hand.check_chain` refuses it).
+
+    ``tips`` (k, 3): the fingertip, ``joints`` (j, k, 3): its hinges' positions palm side first, hand frame,
+    m, from open (first) to closed (last). Every link a capsule of the finger's radius. Resampled at
+    ``tolerances.MODEL_CHAIN_SAMPLES`` closing progresses whose tips have moved evenly along their path on the
+    palm plane, rounded to a micrometre.
+    """
+    if len(joints) == 0:
+        return None, f"finger {finger.name!r}: no hinge joint between palm and tip"
+    points = np.concatenate([np.transpose(joints, (1, 0, 2)), np.asarray(tips)[:, None]], axis=1)  # (k, j + 1, 3)
+    if points.shape[1] > tol.MAX_CHAIN_POINTS:
+        return None, (f"finger {finger.name!r}: {points.shape[1] - 1} hinge joints between palm and tip "
+                      f"(a measured chain has at most {tol.MAX_CHAIN_POINTS - 1})")
+    steps = np.linalg.norm(np.diff(np.asarray(tips)[:, :2], axis=0), axis=1)
+    progress, first = np.unique(np.r_[0.0, np.cumsum(steps)], return_index=True)  # a still tip's repeats dropped
+    at = np.interp(np.linspace(0.0, progress[-1], tol.MODEL_CHAIN_SAMPLES), progress, first.astype(float))
+    k = np.minimum(np.floor(at).astype(int), len(points) - 2)
+    w = (at - k)[:, None, None]
+    resampled = np.round((1.0 - w) * points[k] + w * points[k + 1], 6)
+    try:
+        chain = SampledChain(joints=resampled, radius=finger.radius)
         check_chain(finger, chain)
     except HandError as err:
         return None, str(err)

@@ -46,11 +46,16 @@ for the simulated hand (reference: the finger that closes last).
 
 *3-D chain.* A ray finger whose path from the palm to its tip has exactly two moving hinge joints is
 given a :class:`~contourgrasp.hand.FingerChain`: knuckle at the first joint, links from joint to
-joint to tip, its open and closed joint angles measured in the chain's plane. The hand keeps its
-chains and a palm (the palm geoms' rectangle on the palm plane) only when every finger has one and
-each passes :func:`~contourgrasp.hand.check_chain`; otherwise it is a 2-D hand, and
-:attr:`Derivation.notes` says why. Finger radius: half the smallest extent of the fingertip body's
-collision geoms.
+joint to tip, its open and closed joint angles measured in the chain's plane, when it passes
+:func:`~contourgrasp.hand.check_chain`. Any other finger (an arc, more hinges, a chain out of its
+plane) is given its chain as measured, a :class:`~contourgrasp.hand.SampledChain`: its hinges'
+anchors and its tip along the recorded closing (:func:`~contourgrasp.sim.model_fit.sampled_chain`),
+every link a capsule of the finger's radius (a bounding capsule of each link's geoms was tried and
+refused too much: README, "The bench on the models"). The palm (:func:`_palm_plate`): one collision
+geom's box gives its tilted underside face; several give their rectangle, as deep as their deepest
+corner. The hand keeps its chains and palm only when every finger has a chain; otherwise it is a 2-D
+hand, and :attr:`Derivation.notes` says why. Finger radius: half the smallest extent of the
+fingertip body's collision geoms.
 
 *Gains.* The model says nothing about the planner's gains: every finger gets ``alpha`` 25 and
 ``beta`` 10000 (the five-finger preset's), none is required, and ``min_touching`` is every finger
@@ -70,10 +75,11 @@ os.environ.setdefault("MUJOCO_GL", "disable")
 import mujoco  # noqa: E402
 
 from .. import tolerances as tol  # noqa: E402
+from ..contour.polygon import signed_area  # noqa: E402
 from ..errors import HandError, HandFileError, SimulationError  # noqa: E402
 from ..hand import Hand, Palm  # noqa: E402
 from .calibrate import Closing, derive_virtual_starts  # noqa: E402
-from .model_fit import FingerFit, fit_chain, fit_finger, travelled  # noqa: E402
+from .model_fit import FingerFit, fit_chain, fit_finger, sampled_chain, travelled  # noqa: E402
 from .scene import TIMESTEP, mujoco_warnings  # noqa: E402
 
 #: Time the open hand settles before closing, s.
@@ -618,8 +624,40 @@ def _palm_geoms(m, d, palm: int, subtree: set[int], axes: np.ndarray, collides: 
 
 
 def _palm_plate(corners: np.ndarray) -> Palm:
-    (x0, y0, z0), (x1, y1, _) = corners.min(axis=0), corners.max(axis=0)
-    return Palm(outline=((x0, y0), (x1, y0), (x1, y1), (x0, y1)), thickness=max(float(-z0), tol.FINGER_MOVED))
+    """The palm's plate from its collision geoms' bounding-box corners (8 per geom, hand frame).
+
+    One geom: the box's face toward the object that covers the most of the palm plane (:func:`_underside_face`)
+    is the underside, tilted as the box is, and the plate is as thick as the box above it. Several: their rectangle on the palm plane,
+    its underside as deep as their deepest corner (below z = 0 only) -- the palm's lowest point everywhere
+    under it, on the safe side.
+    """
+    if len(corners) == 8:
+        face = _underside_face(corners)
+        palm = Palm(outline=tuple(map(tuple, face)), thickness=tol.FINGER_MOVED)
+        above = float((np.c_[np.ones(8), corners[:, :2]] @ palm.plane - corners[:, 2]).max())
+        return replace(palm, thickness=max(above, tol.FINGER_MOVED))
+    (x0, y0, z0), (x1, y1, z1) = corners.min(axis=0), corners.max(axis=0)
+    depth = max(float(z1), 0.0)
+    return Palm(outline=((x0, y0), (x1, y0), (x1, y1), (x0, y1)), thickness=max(depth - float(z0), tol.FINGER_MOVED),
+                depths=(depth,) * 4)
+
+
+def _underside_face(box: np.ndarray) -> np.ndarray:
+    """(4, 3) float: the corners, in order around it, of the face of a box (its 8 corners in :data:`_CORNERS`'s
+    order) that faces the object (outward normal with +z) and covers the most of the palm plane."""
+    centre = box.mean(axis=0)
+    best, face = -np.inf, None
+    for axis in range(3):
+        others = [a for a in range(3) if a != axis]
+        for side in (0, 1):
+            index = [sum(b << (2 - a) for a, b in zip([axis, *others], (side, *pair), strict=True))
+                     for pair in ((0, 0), (1, 0), (1, 1), (0, 1))]
+            if box[index].mean(axis=0)[2] <= centre[2]:
+                continue
+            shadow = abs(signed_area(box[index, :2]))
+            if shadow > best:
+                best, face = shadow, box[index]
+    return face
 
 
 def _tip_radius(m, tip: tuple[str, int], collides: np.ndarray) -> float:
@@ -656,7 +694,9 @@ def _with_chains(hand: Hand, closed: ClosedModel, ends: list[int]) -> tuple[Hand
         k = ends[i] + 1
         chain, why = fit_chain(finger, closed.tips[i, :k], closed.joints[i][:, :k])
         if chain is None:
-            notes.append(why)
+            chain, why_not = sampled_chain(finger, closed.tips[i, :k], closed.joints[i][:, :k])
+            if chain is None:
+                notes.append(f"{why}; measured: {why_not}")
         chains.append(chain)
     if notes:
         return hand, tuple(notes)

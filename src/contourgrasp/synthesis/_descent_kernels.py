@@ -27,7 +27,7 @@ def map_clearances(heights, hand, poses, base, ends, radii) -> np.ndarray:
                float(heights.cell), np.asarray(heights.table_normal, dtype=float), np.ascontiguousarray(poses, dtype=float),
                np.ascontiguousarray(base, dtype=float), np.ascontiguousarray(ends, dtype=float),
                np.ascontiguousarray(radii, dtype=float), np.ascontiguousarray(hand.palm.points, dtype=float),
-               VERTICAL_AXIS, out)
+               np.ascontiguousarray(hand.palm.plane, dtype=float), VERTICAL_AXIS, out)
     return out
 
 
@@ -87,18 +87,22 @@ def _gap(layer, origin, cell, normal, i, k, x, y, c, s, ends, r, base, vertical)
 
 
 @njit(cache=True)
-def _palm_gap(layer, origin, cell, normal, i, k, x, y, c, s, outline, base):
-    """The gap of the palm's underside (z = 0) over cell (i, k); +inf when the cell's centre is outside its outline."""
+def _palm_gap(layer, origin, cell, normal, i, k, x, y, c, s, outline, plane, base):
+    """The gap of the palm's underside (z = plane . (1, x, y), hand frame) over cell (i, k); +inf when the cell's
+    centre is outside its outline."""
     cx, cy = origin[0] + (k + 0.5) * cell, origin[1] + (i + 0.5) * cell
     dx, dy = cx - x, cy - y
-    if not _inside(c * dx + s * dy, -s * dx + c * dy, outline):
+    hx, hy = c * dx + s * dy, -s * dx + c * dy
+    if not _inside(hx, hy, outline):
         return math.inf
-    return normal[0] * cx + normal[1] * cy + base - _cell(layer, i, k)
+    z = plane[0] + plane[1] * hx + plane[2] * hy
+    return normal[0] * cx + normal[1] * cy + normal[2] * z + base - _cell(layer, i, k)
 
 
 @njit(cache=True)
-def clearances(layer, origin, cell, normal, poses, base, ends, radii, palm, vertical, out):
-    """Fill out (p, n_capsules + 1): per pose the least gap of each capsule (ends (n, 2, 3), radii (n,)) and the palm."""
+def clearances(layer, origin, cell, normal, poses, base, ends, radii, palm, plane, vertical, out):
+    """Fill out (p, n_capsules + 1): per pose the least gap of each capsule (ends (n, 2, 3), radii (n,)) and the palm
+    (its outline (k, 2) and underside plane (3,))."""
     nx_, ny_, nz_ = normal[0], normal[1], normal[2]
     for p in range(poses.shape[0]):
         x, y, c, s = poses[p, 0], poses[p, 1], math.cos(poses[p, 2]), math.sin(poses[p, 2])
@@ -113,7 +117,7 @@ def clearances(layer, origin, cell, normal, poses, base, ends, radii, palm, vert
             for v in range(pts.shape[0]):
                 px, py = x + c * pts[v, 0] - s * pts[v, 1], y + s * pts[v, 0] + c * pts[v, 1]
                 lo_x, hi_x, lo_y, hi_y = min(lo_x, px), max(hi_x, px), min(lo_y, py), max(hi_y, py)
-                z = pts[v, 2] if capsule else 0.0
+                z = pts[v, 2] if capsule else plane[0] + plane[1] * pts[v, 0] + plane[2] * pts[v, 1]
                 lowest = min(lowest, nx_ * px + ny_ * py + nz_ * z + base[p] - r)
             c0 = int(math.floor((lo_x - r - origin[0]) / cell))
             c1 = int(math.floor((hi_x + r - origin[0]) / cell))
@@ -133,5 +137,6 @@ def clearances(layer, origin, cell, normal, poses, base, ends, radii, palm, vert
                     if capsule:
                         least = min(least, _gap(layer, origin, cell, normal, i, k, x, y, c, s, pts, r, base[p], vertical))
                     else:
-                        least = min(least, _palm_gap(layer, origin, cell, normal, i, k, x, y, c, s, pts, base[p]))
+                        least = min(least, _palm_gap(layer, origin, cell, normal, i, k, x, y, c, s, pts, plane,
+                                                     base[p]))
             out[p, j] = least

@@ -15,10 +15,11 @@ centre of the distal link's end cap, the point the simulation's ``tip_depth`` me
 ``tip_height`` above the table. Heights of hand points are the map's, along the table's normal
 (:meth:`HeightMap.height_of`), so a slightly tilted table normal is taken exactly.
 
-Bodies: per finger (in the hand's order) its post, proximal and distal capsules
-(:func:`~contourgrasp.hand.chain_capsules` at s = 0, radius ``chain.radius``), then the palm slab
-(its outline from z = -thickness to 0, whose lowest point is its underside at z = 0):
-``3 * n_fingers + 1`` bodies, named by :func:`body_names`.
+Bodies: per finger (in the hand's order) its post and links -- a planar chain's proximal and
+distal capsules, a sampled chain's links -- (:func:`~contourgrasp.hand.chain_capsules` at s = 0,
+radius ``chain.radius``), then the palm slab (its outline, ``thickness`` above its underside, whose
+lowest point over a cell is the underside there: z = 0, or the plane :attr:`~contourgrasp.hand.Palm.plane`
+of a tilted palm), named by :func:`body_names`.
 
 Why the final pose decides the whole descent
 --------------------------------------------
@@ -80,14 +81,11 @@ import numpy as np
 
 from .. import validation
 from ..errors import HandError, PerceptionError, PlannerError
-from ..hand import Hand, chain_capsules, chain_tip
+from ..hand import Hand, chain_capsules, chain_tip, link_names
 from ..perception.height_map import HeightMap
 from ..tolerances import DESCENT_BATCH, DESCENT_MARGIN, MAX_DESCENT_POSES, MAX_HAND_SIZE
 from ._descent_kernels import map_clearances
 from .sweep import closing_hits, link_first, obstacle_centres, obstacle_map
-
-#: Parts of a finger's chain, in the order of :func:`~contourgrasp.hand.chain_capsules`.
-FINGER_PARTS = ("post", "proximal", "distal")
 
 #: Clearances within this of the margin pass (m): a pose raised to exactly the margin keeps it up to rounding.
 _ROUNDING = 1e-9
@@ -195,9 +193,11 @@ class Descent:
 
 
 def body_names(hand: Hand) -> tuple[str, ...]:
-    """Names of the bodies of :func:`descent_clearance`'s columns: "<finger> <part>" per finger and part, then "palm"."""
+    """Names of the bodies of :func:`descent_clearance`'s columns: "<finger> <part>" per finger and capsule of its
+    chain (:func:`~contourgrasp.hand.link_names`), then "palm"."""
     _check_hand(hand)
-    return tuple(f"{f.name} {part}" for f in hand.fingers for part in FINGER_PARTS) + ("palm",)
+    return tuple(f"{f.name} {part}" for f, c in zip(hand.fingers, hand.chains, strict=True)
+                 for part in link_names(c)) + ("palm",)
 
 
 def descent_clearance(hand: Hand, heights: HeightMap, poses, tip_height) -> np.ndarray:
@@ -216,7 +216,7 @@ def descent_clearance(hand: Hand, heights: HeightMap, poses, tip_height) -> np.n
 
     Returns
     -------
-    (p, 3 * n_fingers + 1) float
+    (p, n_bodies) float
         Per pose and body (:func:`body_names`), m: the least over the cells under the body of its
         lowest point's height minus the cell's (module docstring); +inf for a body over no cell,
         -inf over a cell out of view or off the grid. Negative: the body strikes.
@@ -232,8 +232,9 @@ def descent_clearance(hand: Hand, heights: HeightMap, poses, tip_height) -> np.n
     """
     _check_hand(hand)
     poses, tip, normal = _check_inputs(heights, poses, tip_height)
-    ends = np.concatenate([chain_capsules(c, 0.0)[0] for c in hand.chains])  # (3n, 2, 3)
-    radii = np.repeat([c.radius for c in hand.chains], 3).astype(float)
+    capsules = [chain_capsules(c, 0.0)[0] for c in hand.chains]
+    ends = np.concatenate(capsules)  # (bodies - 1, 2, 3)
+    radii = np.repeat([c.radius for c in hand.chains], [len(e) for e in capsules]).astype(float)
     base = height_base(hand, poses, tip, normal)
     return map_clearances(heights, hand, poses, base, ends, radii)
 

@@ -11,8 +11,12 @@ a pose whose open hand cannot descend that low stops as high as its bodies need,
 ``"clearance"``
     The rule the simulated execution applied before the planner chose a height: the tips just
     above the table while they close (the lowest tip of the closing hand, :attr:`Hand.closing_tip_depth`,
-    its radius plus ``tolerances.GRASP_TIP_CLEARANCE`` up), unless that brings the palm's underside
+    its radius plus ``tolerances.GRASP_TIP_CLEARANCE`` up), unless that brings the palm plane (z = 0)
     closer than ``tolerances.GRASP_PALM_CLEARANCE`` to the object's top; then that high. Never raised.
+    A tilted palm (a hand model's, :attr:`~contourgrasp.hand.Palm.plane`) reaches below that plane
+    at one end; the rule still counts from the plane, and the descent check keeps the tilted
+    underside itself above the object, pose by pose (chosen on the training objects with the Inspire
+    model: README, "The bench on the models").
 ``"auto"``
     The same height asked for, raised where the bodies need it up to
     ``tolerances.GRASP_HEIGHT_FRACTION`` of the object's height: the tips still close on its lower

@@ -8,11 +8,11 @@ ratio cost describe a grasp the hand does not make.
 
 :func:`link_first` checks it on the scene's height map, the 2.5-D solid of
 :mod:`~contourgrasp.synthesis.descent`: with the open hand at its grasp height, each touching
-finger's proximal and distal capsules are placed at ``tolerances.SWEEP_SAMPLES`` closing progresses
-whose tips have travelled evenly from 0 to ``lambda - (radius + tolerances.SWEEP_TOLERANCE)`` along
-the finger's path (the tip's own ball meets the surface about a radius before its centre reaches the
-contour, so that much is not an early contact), and a capsule passing below the map there means the
-chain meets the object early. The hand is not moved while it closes (the thesis's grasp: the arm
+finger's links (a planar chain's proximal and distal capsules) are placed at
+``tolerances.SWEEP_SAMPLES`` closing progresses whose tips have travelled evenly from 0 to
+``lambda - (radius + tolerances.SWEEP_TOLERANCE)`` along the finger's path (the tip's own ball meets
+the surface about a radius before its centre reaches the contour, so that much is not an early
+contact), and a capsule passing below the map there means the chain meets the object early. The hand is not moved while it closes (the thesis's grasp: the arm
 holds still); the palm and the posts do not move relative to it.
 
 Reading of "the chain meets the object": any capsule of the finger below the height map of any
@@ -38,22 +38,22 @@ from functools import lru_cache
 import numpy as np
 
 from .. import tolerances as tol
-from ..hand import FingerChain, Hand, chain_capsules, chain_tip
+from ..hand import FingerChain, Hand, SampledChain, chain_capsules, chain_tip
 from ..perception.height_map import HeightMap
 from ._descent_kernels import map_clearances
 
 
 @lru_cache(maxsize=64)
-def _travel(chain: FingerChain) -> tuple[np.ndarray, np.ndarray]:
+def _travel(chain: FingerChain | SampledChain) -> tuple[np.ndarray, np.ndarray]:
     """(progress, distance the tip has travelled in the palm plane) on ``tolerances.CHAIN_SAMPLES`` progresses."""
     s = np.linspace(0.0, 1.0, tol.CHAIN_SAMPLES)
     tips = chain_tip(chain, s)[:, :2]
     return s, np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(tips, axis=0), axis=1))]
 
 
-def _swept_capsules(chain: FingerChain, reach: float) -> np.ndarray:
-    """(2 m, 2, 3) float: the proximal and distal capsules at ``SWEEP_SAMPLES`` closing progresses whose tips have
-    travelled evenly from 0 to ``reach`` (m) in the palm plane."""
+def _swept_capsules(chain: FingerChain | SampledChain, reach: float) -> np.ndarray:
+    """(k m, 2, 3) float: the k links' capsules (a planar chain's proximal and distal) at ``SWEEP_SAMPLES`` closing
+    progresses whose tips have travelled evenly from 0 to ``reach`` (m) in the palm plane."""
     s_grid, distance = _travel(chain)
     s = np.interp(np.linspace(0.0, reach, tol.SWEEP_SAMPLES), distance, s_grid)
     return chain_capsules(chain, s)[:, 1:].reshape(-1, 2, 3)
@@ -176,6 +176,6 @@ def _near_obstacles(hand: Hand, cell: float, centres, pose, reaches) -> np.ndarr
 
 
 @lru_cache(maxsize=64)
-def _sweep_points(chain: FingerChain) -> np.ndarray:
+def _sweep_points(chain: FingerChain | SampledChain) -> np.ndarray:
     """(k, 2) float: the (x, y) of the capsules' ends over the finger's whole closing, hand frame."""
     return _swept_capsules(chain, float(_travel(chain)[1][-1]))[..., :2].reshape(-1, 2)
