@@ -75,7 +75,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from functools import cached_property, partial
+from functools import cached_property, lru_cache, partial
 
 import numpy as np
 
@@ -196,8 +196,27 @@ def body_names(hand: Hand) -> tuple[str, ...]:
     """Names of the bodies of :func:`descent_clearance`'s columns: "<finger> <part>" per finger and capsule of its
     chain (:func:`~contourgrasp.hand.link_names`), then "palm"."""
     _check_hand(hand)
-    return tuple(f"{f.name} {part}" for f, c in zip(hand.fingers, hand.chains, strict=True)
-                 for part in link_names(c)) + ("palm",)
+    return _open_hand(hand).names
+
+
+@dataclass(frozen=True, eq=False)
+class _OpenHand:
+    """The open hand's bodies (hand frame), found once per hand: the search checks it batch after batch."""
+
+    capsules: np.ndarray  # (bodies - 1, 2, 3)
+    radii: np.ndarray  # (bodies - 1,)
+    tips: np.ndarray  # (n_fingers, 3)
+    names: tuple[str, ...]
+
+
+@lru_cache(maxsize=16)
+def _open_hand(hand: Hand) -> _OpenHand:
+    capsules = [chain_capsules(c, 0.0)[0] for c in hand.chains]
+    radii = np.repeat([c.radius for c in hand.chains], [len(e) for e in capsules]).astype(float)
+    names = tuple(f"{f.name} {part}" for f, c in zip(hand.fingers, hand.chains, strict=True)
+                  for part in link_names(c)) + ("palm",)
+    return _OpenHand(capsules=np.concatenate(capsules), radii=radii,
+                     tips=np.array([chain_tip(c, 0.0)[0] for c in hand.chains]), names=names)
 
 
 def descent_clearance(hand: Hand, heights: HeightMap, poses, tip_height) -> np.ndarray:
@@ -232,11 +251,9 @@ def descent_clearance(hand: Hand, heights: HeightMap, poses, tip_height) -> np.n
     """
     _check_hand(hand)
     poses, tip, normal = _check_inputs(heights, poses, tip_height)
-    capsules = [chain_capsules(c, 0.0)[0] for c in hand.chains]
-    ends = np.concatenate(capsules)  # (bodies - 1, 2, 3)
-    radii = np.repeat([c.radius for c in hand.chains], [len(e) for e in capsules]).astype(float)
+    bodies = _open_hand(hand)
     base = height_base(hand, poses, tip, normal)
-    return map_clearances(heights, hand, poses, base, ends, radii)
+    return map_clearances(heights, hand, poses, base, bodies.capsules, bodies.radii)
 
 
 def height_base(hand: Hand, poses, tip_height, normal) -> np.ndarray:
@@ -245,7 +262,7 @@ def height_base(hand: Hand, poses, tip_height, normal) -> np.ndarray:
 
     The palm's planning depth cancels out: it is fixed by the lowest tip's height.
     """
-    tips = np.array([chain_tip(c, 0.0)[0] for c in hand.chains])  # (n, 3)
+    tips = _open_hand(hand).tips
     c, s = np.cos(poses[:, 2])[:, None], np.sin(poses[:, 2])[:, None]
     tip_x = poses[:, :1] + c * tips[None, :, 0] - s * tips[None, :, 1]
     tip_y = poses[:, 1:2] + s * tips[None, :, 0] + c * tips[None, :, 1]
