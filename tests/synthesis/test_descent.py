@@ -222,6 +222,25 @@ def test_a_hand_of_sampled_chains_descends_as_its_planar_chains(hand):
     assert body_names(sampled) == body_names(hand)
 
 
+def test_refusing_early_keeps_every_verdict_and_the_feasible_poses_exact(hand):
+    wall = scene(lambda x, y: np.where(y > 0.1, 0.12, 0.0))
+    rng = np.random.default_rng(5)
+    poses = np.c_[rng.uniform(-0.1, 0.1, (200, 2)), rng.uniform(0, 2 * np.pi, 200)]
+    exact = descent_feasible(hand, wall, poses, TIP, margin=0.003)
+    early = descent_feasible(hand, wall, poses, TIP, margin=0.003, refuse_below=-0.01)
+    assert exact.exact and not early.exact
+    np.testing.assert_array_equal(early.feasible, exact.feasible)
+    assert 20 < exact.feasible.sum() < 180
+    np.testing.assert_array_equal(early.clearance[exact.feasible], exact.clearance[exact.feasible])
+    refused = exact.clearance.min(axis=1) < -0.01
+    assert refused.sum() > 20
+    assert (early.clearance.min(axis=1)[refused] < -0.01).all()  # found below, its walk stopped there
+    assert (early.clearance[refused] >= exact.clearance[refused]).all()  # upper bounds; bodies not walked +inf
+    assert np.isinf(early.clearance[refused]).any()
+    with pytest.raises(PlannerError, match="refuse_below"):
+        descent_feasible(hand, wall, poses, TIP, refuse_below=np.nan)
+
+
 def test_bad_arguments_are_refused_by_name(hand):
     hm = scene(lambda x, y: 0.0)
     with pytest.raises(HandError, match="no 3-D geometry"):

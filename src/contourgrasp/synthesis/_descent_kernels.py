@@ -18,16 +18,22 @@ from numba import njit
 from ..tolerances import VERTICAL_AXIS
 
 
-def map_clearances(heights, hand, poses, base, ends, radii) -> np.ndarray:
+def map_clearances(heights, hand, poses, base, ends, radii, stop=None) -> np.ndarray:
     """(p, n + 1) float: the least gap over ``heights`` (a HeightMap's conservative layer) of each capsule
     (``ends`` (n, 2, 3), ``radii`` (n,), hand frame) and of ``hand``'s palm, per pose (p, 3) with its height
-    offset ``base`` (p,)."""
+    offset ``base`` (p,).
+
+    ``stop`` (p,) float, optional: a pose's walk ends at the first gap found below its ``stop`` -- the pose is
+    refused whatever the rest -- that body's gap kept (an upper bound of its least) and every body not yet
+    walked +inf.
+    """
     out = np.empty((len(poses), len(ends) + 1))
+    stop = np.full(len(poses), -np.inf) if stop is None else np.ascontiguousarray(stop, dtype=float)
     clearances(np.ascontiguousarray(heights.conservative(), dtype=float), np.asarray(heights.origin, dtype=float),
                float(heights.cell), np.asarray(heights.table_normal, dtype=float), np.ascontiguousarray(poses, dtype=float),
                np.ascontiguousarray(base, dtype=float), np.ascontiguousarray(ends, dtype=float),
                np.ascontiguousarray(radii, dtype=float), np.ascontiguousarray(hand.palm.points, dtype=float),
-               np.ascontiguousarray(hand.palm.plane, dtype=float), VERTICAL_AXIS, out)
+               np.ascontiguousarray(hand.palm.plane, dtype=float), VERTICAL_AXIS, stop, out)
     return out
 
 
@@ -100,13 +106,17 @@ def _palm_gap(layer, origin, cell, normal, i, k, x, y, c, s, outline, plane, bas
 
 
 @njit(cache=True)
-def clearances(layer, origin, cell, normal, poses, base, ends, radii, palm, plane, vertical, out):
+def clearances(layer, origin, cell, normal, poses, base, ends, radii, palm, plane, vertical, stop, out):
     """Fill out (p, n_capsules + 1): per pose the least gap of each capsule (ends (n, 2, 3), radii (n,)) and the palm
-    (its outline (k, 2) and underside plane (3,))."""
+    (its outline (k, 2) and underside plane (3,)); a pose's walk ends at a gap below its ``stop`` (p,)."""
     nx_, ny_, nz_ = normal[0], normal[1], normal[2]
     for p in range(poses.shape[0]):
         x, y, c, s = poses[p, 0], poses[p, 1], math.cos(poses[p, 2]), math.sin(poses[p, 2])
+        refused = False
         for j in range(ends.shape[0] + 1):
+            if refused:
+                out[p, j] = math.inf
+                continue
             capsule = j < ends.shape[0]
             if capsule:
                 pts, r = ends[j], radii[j]
@@ -131,6 +141,8 @@ def clearances(layer, origin, cell, normal, poses, base, ends, radii, palm, plan
                 least = _gap(layer, origin, cell, normal, int(math.floor((ey - origin[1]) / cell)),
                              int(math.floor((ex - origin[0]) / cell)), x, y, c, s, pts, r, base[p], vertical)
             for i in range(r0, r1 + 1):
+                if least < stop[p]:
+                    break
                 for k in range(c0, c1 + 1):
                     if lowest - _cell(layer, i, k) >= least:
                         continue
@@ -139,4 +151,7 @@ def clearances(layer, origin, cell, normal, poses, base, ends, radii, palm, plan
                     else:
                         least = min(least, _palm_gap(layer, origin, cell, normal, i, k, x, y, c, s, pts, plane,
                                                      base[p]))
+                    if least < stop[p]:
+                        break
             out[p, j] = least
+            refused = least < stop[p]

@@ -111,6 +111,10 @@ class DescentCheck:
         The grasp height each pose was checked at, m.
     poses : (p, 3) float
         The poses checked.
+    exact : bool
+        False when checked with ``refuse_below``: a pose found below it has that body's clearance as an
+        upper bound and the bodies not walked +inf; its ``blocking`` and :meth:`reason` say only that it is
+        refused.
     """
 
     feasible: np.ndarray
@@ -120,6 +124,7 @@ class DescentCheck:
     margin: float
     tip_height: np.ndarray
     poses: np.ndarray
+    exact: bool = True
 
     def reason(self, i: int) -> str:
         """Why pose ``i`` is refused (or that it is not), e.g. "the index distal strikes the map 3.0 mm deep"."""
@@ -249,11 +254,16 @@ def descent_clearance(hand: Hand, heights: HeightMap, poses, tip_height) -> np.n
     PlannerError
         ``poses`` or ``tip_height`` not finite or of the wrong shape.
     """
+    return _clearance(hand, heights, poses, tip_height)
+
+
+def _clearance(hand: Hand, heights: HeightMap, poses, tip_height, refuse_below: float | None = None) -> np.ndarray:
     _check_hand(hand)
     poses, tip, normal = _check_inputs(heights, poses, tip_height)
     bodies = _open_hand(hand)
     base = height_base(hand, poses, tip, normal)
-    return map_clearances(heights, hand, poses, base, bodies.capsules, bodies.radii)
+    stop = None if refuse_below is None else np.full(len(poses), refuse_below)
+    return map_clearances(heights, hand, poses, base, bodies.capsules, bodies.radii, stop)
 
 
 def height_base(hand: Hand, poses, tip_height, normal) -> np.ndarray:
@@ -269,11 +279,15 @@ def height_base(hand: Hand, poses, tip_height, normal) -> np.ndarray:
     return tip_height - (normal[0] * tip_x + normal[1] * tip_y + normal[2] * tips[None, :, 2]).min(axis=1)
 
 
-def descent_feasible(hand: Hand, heights: HeightMap, poses, tip_height, *, margin: float = 0.0) -> DescentCheck:
+def descent_feasible(hand: Hand, heights: HeightMap, poses, tip_height, *, margin: float = 0.0,
+                     refuse_below: float | None = None) -> DescentCheck:
     """Which poses the open hand can descend to without any body passing below the map (plus ``margin``).
 
-    Parameters are :func:`descent_clearance`'s, and ``margin`` (m, in [0, ``MAX_HAND_SIZE``]) the
-    clearance every body must keep.
+    Parameters are :func:`descent_clearance`'s, ``margin`` (m, in [0, ``MAX_HAND_SIZE``]) the
+    clearance every body must keep, and ``refuse_below`` (m, optional) a clearance below which a pose
+    is refused whatever its other bodies: its walk over the map stops there (``DescentCheck.exact``
+    False). The search passes what no raising of the grasp height can make up for; the feasible
+    poses' clearances are exact either way.
 
     Returns
     -------
@@ -286,13 +300,15 @@ def descent_feasible(hand: Hand, heights: HeightMap, poses, tip_height, *, margi
         As :func:`descent_clearance`; PlannerError for a bad ``margin``.
     """
     margin = validation.bounded("margin", margin, MAX_HAND_SIZE, " m", error=PlannerError)
-    clearance = descent_clearance(hand, heights, poses, tip_height)
+    if refuse_below is not None:
+        refuse_below = validation.finite("refuse_below", refuse_below, error=PlannerError)
+    clearance = _clearance(hand, heights, poses, tip_height, refuse_below)
     worst = clearance.argmin(axis=1) if clearance.size else np.zeros(0, dtype=int)
     feasible = clearance.min(axis=1) >= margin - _ROUNDING if len(clearance) else np.zeros(0, dtype=bool)
     tip = np.broadcast_to(np.asarray(tip_height, dtype=float), (len(clearance),)).copy()
     return DescentCheck(feasible=feasible, clearance=clearance, blocking=np.where(feasible, -1, worst),
                         bodies=body_names(hand), margin=margin, tip_height=tip,
-                        poses=np.asarray(poses, dtype=float).reshape(-1, 3))
+                        poses=np.asarray(poses, dtype=float).reshape(-1, 3), exact=refuse_below is None)
 
 
 def descent_floor(hand: Hand, heights: HeightMap, poses) -> np.ndarray:
@@ -343,7 +359,8 @@ def check_candidates(hand: Hand, descent: Descent, poses, order, lam=None,
     order = np.asarray(order, dtype=np.intp)[:MAX_DESCENT_POSES]
     for a in range(0, len(order), DESCENT_BATCH):
         rows = order[a:a + DESCENT_BATCH]
-        last = descent_feasible(hand, descent.heights, poses[rows], descent.tip_height, margin=descent.margin)
+        last = descent_feasible(hand, descent.heights, poses[rows], descent.tip_height, margin=descent.margin,
+                                refuse_below=descent.margin - (descent.max_tip_height - descent.tip_height) - _ROUNDING)
         raised = _raised(last)
         tip[rows] = raised
         passed[rows] = raised <= descent.max_tip_height

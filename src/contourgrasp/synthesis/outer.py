@@ -413,6 +413,8 @@ def _by_cost(result: PoseEvaluation) -> np.ndarray:
 
 def _diagnose_descent(hand: Hand, check: DescentCheck, n: int, descent: Descent) -> str:
     """Why every pose that reaches the object fails the descent check, with the best one's reason."""
+    if not check.exact:  # the search stopped walking a refused pose at its first strike: walk it all now
+        check = descent_feasible(hand, descent.heights, check.poses, check.tip_height, margin=check.margin)
     best = int(np.argmax(check.clearance.min(axis=1)))
     limit = (f"at a grasp height of {1000 * descent.tip_height:.0f} mm" if descent.max_tip_height == descent.tip_height
              else f"at any grasp height from {1000 * descent.tip_height:.0f} to {1000 * descent.max_tip_height:.0f} mm")
