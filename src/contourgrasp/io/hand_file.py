@@ -45,8 +45,8 @@ Schema (all lengths in meters, angles in radians)::
 
 A 3-D part inconsistent with the 2-D one (the chain's open tip more than 1 mm from ``start``
 on the palm plane, its closed tip more than 1 mm from the end of the travel, or its tip path
-more than 1 mm off the ray or arc: :func:`contourgrasp.hand.check_chain`) is refused naming
-the finger.
+more than 1 mm off the ray or arc: :func:`contourgrasp.hand.check_chain`; 3 mm for a measured
+chain, the fit tolerance of ``hand-from-model``) is refused naming the finger.
 
 Lengths are at most ``tolerances.MAX_HAND_SIZE`` (2 m) in magnitude, ``|phi_off|`` at most
 ``tolerances.MAX_ARC_ANGLE``, gains (alpha, beta, miss_penalty) at most ``tolerances.MAX_GAIN``
