@@ -77,3 +77,26 @@ def test_image_plan_figure_has_a_height_panel(tmp_path):
     fig.savefig(tmp_path / "p.png")
     # Without a height map (no table plane), the two panels of before.
     assert len(visualize.image_plan_figure(replace(result, height_map=None)).axes) == 2
+
+
+def test_the_side_view_draws_a_hand_of_measured_chains_in_each_fingers_plane(tmp_path):
+    # a hand of SampledChains (as hand-from-model writes for a model's curling fingers) has no knuckle or
+    # direction of its own: its side view takes the plane from its open pose (hand.chain_plane)
+    from contourgrasp.hand import SampledChain, chain_joints, chain_plane
+
+    three = cg.load_hand("three-finger")
+    sampled = replace(three, chains=tuple(SampledChain(joints=chain_joints(c, np.linspace(0, 1, 11)), radius=c.radius)
+                                          for c in three.chains))
+    for planar, measured in zip(three.chains, sampled.chains, strict=True):
+        knuckle, direction = chain_plane(measured)
+        np.testing.assert_allclose(knuckle, planar.knuckle, atol=1e-12)
+        assert direction @ np.asarray(planar.direction) == pytest.approx(1.0)  # the open tip leans along it
+    folder = Path(__file__).resolve().parents[1] / "examples" / "bar_clamp"
+    frame = read_rgbd(folder / "color_0.png", folder / "depth_0.npy", folder / "primesense_overhead_color.intr")
+    result = cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, sampled, planner="default", xy_step=0.03,
+                           yaw_step=math.radians(6))
+    assert result.grasp_height is not None
+    fig = visualize.image_plan_figure(result, frame.rgb)
+    side = [ax for ax in fig.axes if ax.get_title().startswith("each finger's plane at the grasp")]
+    assert len(side) == 1 and len(side[0].lines) >= 3 * 3  # every finger's post and two links
+    fig.savefig(tmp_path / "side.png")

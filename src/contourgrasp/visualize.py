@@ -17,7 +17,7 @@ from matplotlib.figure import Figure
 from mpl_toolkits.axes_grid1.anchored_artists import AnchoredSizeBar
 
 from . import contour as efd_model
-from .hand import chain_capsules, to_image
+from .hand import chain_capsules, chain_plane, to_image
 from .synthesis import GraspPlan
 
 CONVEX_COLOUR = "0.25"
@@ -209,8 +209,8 @@ def image_plan_figure(result, rgb=None) -> Figure:
 def draw_side_view(ax, heights, plan: GraspPlan, grasp_height: float) -> None:
     """Each finger's body at the grasp height beside the scene, in the vertical plane the finger closes in.
 
-    Horizontal: distance from the finger's knuckle along its chain's direction (toward the object);
-    vertical: height above the table. Per finger, in its colour: the height map's profile along that
+    Horizontal: distance from the finger's knuckle along its chain's plane (:func:`~contourgrasp.hand.chain_plane`,
+    toward the object); vertical: height above the table. Per finger, in its colour: the height map's profile along that
     line (filled; unseen cells at their conservative bound, dotted) and its open chain's links.
     """
     hand = plan.hand
@@ -219,7 +219,7 @@ def draw_side_view(ax, heights, plan: GraspPlan, grasp_height: float) -> None:
     bound = heights.conservative()
     for i, (finger, chain) in enumerate(zip(hand.fingers, hand.chains)):
         colour = FINGER_COLOURS[i % len(FINGER_COLOURS)]
-        knuckle, direction = np.asarray(chain.knuckle), np.asarray(chain.direction)
+        knuckle, direction = chain_plane(chain)
         line = to_image(knuckle + u[:, None] * direction, plan.pose)
         seen, hidden = heights.at(line), heights.at(line, bound)
         ax.fill_between(u, 0.0, np.nan_to_num(seen), color=colour, alpha=0.15, step="mid")

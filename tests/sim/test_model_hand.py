@@ -192,3 +192,10 @@ def test_a_palm_box_gives_its_underside_and_several_their_deepest_rectangle():
     two = _palm_plate(np.vstack([box_corners([0.0, 0.0, -0.01], [0.05, 0.04, 0.01]),
                                  box_corners([0.08, 0.0, 0.0], [0.02, 0.02, 0.015])]))
     assert two.depths == (0.015,) * 4 and two.points[:, 0].max() == pytest.approx(0.1)
+
+
+def test_our_simulated_hand_is_not_built_from_measured_chains():
+    from contourgrasp.errors import SimulationError
+
+    with pytest.raises(SimulationError, match=r"finger .thumb. has a measured chain .*\(bench --hand-model\)"):
+        build_hand(derive_hand("jaco-three-finger").hand)

@@ -24,6 +24,7 @@ from .chain import (
     chain_capsules,
     chain_deviation,
     chain_joints,
+    chain_plane,
     chain_tip,
     check_chain,
     link_names,
@@ -39,7 +40,7 @@ from .trajectory import (
 )
 
 __all__ = ["Arc", "Finger", "FingerChain", "Hand", "HandSegments", "Palm", "Ray", "SampledChain", "chain_angles",
-           "chain_capsules", "chain_deviation", "chain_joints", "chain_tip", "check_chain", "link_names",
+           "chain_capsules", "chain_deviation", "chain_joints", "chain_plane", "chain_tip", "check_chain", "link_names",
            "polyline_distance", "rotation", "to_image", "trajectory_polyline"]
 
 

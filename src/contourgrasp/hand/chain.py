@@ -342,6 +342,27 @@ def chain_capsules(chain: FingerChain | SampledChain, s) -> np.ndarray:
     return np.concatenate([post[:, None], np.stack([joints[:, :-1], joints[:, 1:]], axis=2)], axis=1)
 
 
+def chain_plane(chain: FingerChain | SampledChain) -> tuple[np.ndarray, np.ndarray]:
+    """The vertical plane a finger closes in: its knuckle's (x, y) and a horizontal unit direction it closes along.
+
+    A :class:`FingerChain`'s own ``knuckle`` and ``direction``; a :class:`SampledChain`'s open knuckle and the
+    direction of its tip's motion from open to closed (from the knuckle to the open tip where the tip ends
+    where it began). A measured chain need not lie in one plane: this is a plane to draw it in.
+
+    Returns
+    -------
+    knuckle, direction : (2,) float
+    """
+    if isinstance(chain, FingerChain):
+        return np.asarray(chain.knuckle), np.asarray(chain.direction)
+    open_, closed = chain_joints(chain, [0.0, 1.0])
+    knuckle = open_[0, :2]
+    for towards in (closed[-1, :2] - open_[-1, :2], open_[-1, :2] - knuckle):
+        if np.linalg.norm(towards) > tol.FINGER_MOVED:
+            return knuckle, towards / np.linalg.norm(towards)
+    return knuckle, np.array([1.0, 0.0])
+
+
 def link_names(chain: FingerChain | SampledChain) -> tuple[str, ...]:
     """Names of :func:`chain_capsules`'s capsules: "post", then "proximal", ("middle",) "distal", or "link k"."""
     links = chain_joints(chain, 0.0).shape[1] - 1
