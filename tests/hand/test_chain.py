@@ -231,3 +231,5 @@ def test_a_tilted_palm_is_the_plane_through_its_vertices():
         Palm(outline=((0, 0), (0.1, 0), (0.1, 0.1), (0, 0.1)), thickness=0.02, depths=(0, 0, 0, 0.002))
     with pytest.raises(HandError, match="one finite number per outline vertex"):
         Palm(outline=((0, 0), (0.1, 0), (0.1, 0.1)), thickness=0.02, depths=(0, 0))
+    with pytest.raises(HandError, match="depths given twice"):
+        Palm(outline=((0, 0, 0), (0.1, 0, 0), (0.1, 0.1, 0)), thickness=0.02, depths=(0, 0, 0))

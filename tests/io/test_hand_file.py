@@ -257,7 +257,7 @@ def test_a_measured_chain_and_a_tilted_palm_load_and_round_trip():
          r"fingers\[0\] \(left\)\.chain: give either joints \(a measured chain\) or the planar chain's keys, not both"),
         ("joints = [[", "joints = [[[0.0, 0.0, 0.0], ", r"fingers\[0\] \(left\)\.chain: every sample of joints must have"),
         ("joints = [[", "joints = [[[0.0, 0.0]], [", r"fingers\[0\] \(left\)\.chain\.joints\[0\]\[0\]: List should have at least 3"),
-        ("0.016], [0.08, 0.02, 0.016]", "0.016], [0.08, 0.02, 0.026]", r"palm: palm: the outline's vertices are 2\.50 mm off one plane"),
+        ("0.016], [0.08, 0.02, 0.016]", "0.016], [0.08, 0.02, 0.026]", r"palm: palm outline's vertices are 2\.50 mm off one plane"),
     ],
 )
 def test_measured_chain_and_tilted_palm_errors_name_the_field(old, new, message):

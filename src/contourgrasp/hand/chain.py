@@ -205,7 +205,7 @@ class Palm:
         depths = pts[:, 2] if pts.shape[1] == 3 else self.depths
         if depths is not None:
             if pts.shape[1] == 3 and self.depths is not None:
-                raise HandError("palm: give the vertices' depths in the outline or as depths, not both")
+                raise HandError("palm depths given twice: in the outline's (x, y, z) vertices and as depths")
             depths = check.float_array("palm depths", depths, error=HandError)
             if depths.shape != (len(pts),) or not np.isfinite(depths).all():
                 raise HandError(f"palm depths must be one finite number per outline vertex ({len(pts)}), "
@@ -222,7 +222,7 @@ class Palm:
         if self.depths is not None:
             off = float(np.abs(np.c_[np.ones(len(pts)), pts] @ self.plane - np.asarray(self.depths)).max())
             if off > tol.PALM_PLANARITY:
-                raise HandError(f"palm: the outline's vertices are {1000 * off:.2f} mm off one plane "
+                raise HandError(f"palm outline's vertices are {1000 * off:.2f} mm off one plane "
                                 f"(at most {1000 * tol.PALM_PLANARITY:g} mm)")
 
     @property
