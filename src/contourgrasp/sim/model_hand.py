@@ -626,10 +626,10 @@ def _palm_geoms(m, d, palm: int, subtree: set[int], axes: np.ndarray, collides: 
 def _palm_plate(corners: np.ndarray) -> Palm:
     """The palm's plate from its collision geoms' bounding-box corners (8 per geom, hand frame).
 
-    One geom: the box's face toward the object that covers the most of the palm plane (:func:`_underside_face`)
-    is the underside, tilted as the box is, and the plate is as thick as the box above it. Several: their rectangle on the palm plane,
-    its underside as deep as their deepest corner (below z = 0 only) -- the palm's lowest point everywhere
-    under it, on the safe side.
+    One geom: the box's face toward the object that covers the most of the palm plane
+    (:func:`_underside_face`) is the underside, tilted as the box is, and the plate is as thick as the
+    box above it. Several: their rectangle on the palm plane, its underside as deep as their deepest
+    corner (below z = 0 only) -- the palm's lowest point everywhere under it, on the safe side.
     """
     if len(corners) == 8:
         face = _underside_face(corners)

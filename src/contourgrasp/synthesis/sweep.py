@@ -12,8 +12,9 @@ finger's links (a planar chain's proximal and distal capsules) are placed at
 ``tolerances.SWEEP_SAMPLES`` closing progresses whose tips have travelled evenly from 0 to
 ``lambda - (radius + tolerances.SWEEP_TOLERANCE)`` along the finger's path (the tip's own ball meets
 the surface about a radius before its centre reaches the contour, so that much is not an early
-contact), and a capsule passing below the map there means the chain meets the object early. The hand is not moved while it closes (the thesis's grasp: the arm
-holds still); the palm and the posts do not move relative to it.
+contact), and a capsule passing below the map there means the chain meets the object early. The
+hand is not moved while it closes (the thesis's grasp: the arm holds still); the palm and the posts
+do not move relative to it.
 
 Reading of "the chain meets the object": any capsule of the finger below the height map of any
 raised cell, the object's or an obstacle's. A finger that misses is not checked (it closes on air in
