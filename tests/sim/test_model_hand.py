@@ -199,3 +199,10 @@ def test_our_simulated_hand_is_not_built_from_measured_chains():
 
     with pytest.raises(SimulationError, match=r"finger .thumb. has a measured chain .*\(bench --hand-model\)"):
         build_hand(derive_hand("jaco-three-finger").hand)
+
+
+def test_the_fit_table_says_which_chains_are_measured():
+    from contourgrasp.sim.model_hand import fit_table
+
+    assert fit_table(derive_hand("jaco-three-finger"))[-1] == (
+        "3-D chains and palm: yes (as measured: thumb, index, pinky, the palm tilted)")

@@ -77,7 +77,7 @@ import mujoco  # noqa: E402
 from .. import tolerances as tol  # noqa: E402
 from ..contour.polygon import signed_area  # noqa: E402
 from ..errors import HandError, HandFileError, SimulationError  # noqa: E402
-from ..hand import Hand, Palm  # noqa: E402
+from ..hand import Hand, Palm, SampledChain  # noqa: E402
 from .calibrate import Closing, derive_virtual_starts  # noqa: E402
 from .model_fit import FingerFit, fit_chain, fit_finger, sampled_chain, travelled  # noqa: E402
 from .scene import TIMESTEP, mujoco_warnings  # noqa: E402
@@ -711,5 +711,12 @@ def fit_table(derivation: Derivation) -> list[str]:
         start = f"{1000 * f.start[0]:.1f}, {1000 * f.start[1]:.1f}"
         lines.append(f"{f.name:8s} {fit.kind:4s} {start:>16s} {1000 * f.travel:10.1f} {1000 * f.virtual_start:+15.1f} "
                      f"{1000 * fit.error:13.2f} {1000 * fit.ray_error:13.2f}")
-    lines.append("3-D chains and palm: " + ("yes" if derivation.hand.is_3d else "no (" + "; ".join(derivation.notes) + ")"))
+    hand = derivation.hand
+    if hand.is_3d:
+        measured = [f.name for f, c in zip(hand.fingers, hand.chains, strict=True) if isinstance(c, SampledChain)]
+        tilted = ", the palm tilted" if hand.palm.depths is not None else ""
+        lines.append("3-D chains and palm: yes" + (f" (as measured: {', '.join(measured)}{tilted})" if measured
+                                                   else f" ({tilted[2:]})" if tilted else ""))
+    else:
+        lines.append("3-D chains and palm: no (" + "; ".join(derivation.notes) + ")")
     return lines
