@@ -220,8 +220,10 @@ def _open_hand(hand: Hand) -> _OpenHand:
     radii = np.repeat([c.radius for c in hand.chains], [len(e) for e in capsules]).astype(float)
     names = tuple(f"{f.name} {part}" for f, c in zip(hand.fingers, hand.chains, strict=True)
                   for part in link_names(c)) + ("palm",)
-    return _OpenHand(capsules=np.concatenate(capsules), radii=radii,
-                     tips=np.array([chain_tip(c, 0.0)[0] for c in hand.chains]), names=names)
+    arrays = np.concatenate(capsules), radii, np.array([chain_tip(c, 0.0)[0] for c in hand.chains])
+    for array in arrays:
+        array.flags.writeable = False  # shared by every check of this hand
+    return _OpenHand(*arrays, names=names)
 
 
 def descent_clearance(hand: Hand, heights: HeightMap, poses, tip_height) -> np.ndarray:
