@@ -169,31 +169,6 @@ def test_bad_models_are_refused_naming_what(sliders, tmp_path):
     assert set(MODELS) == {"inspire", "jaco-three-finger"}
 
 
-def box_corners(centre, half, turn=0.0):
-    """(8, 3) float: a box's corners in model_hand._CORNERS's order, turned by ``turn`` about the y axis."""
-    from contourgrasp.sim.model_hand import _CORNERS
-
-    c, s = np.cos(turn), np.sin(turn)
-    rotation = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-    return np.asarray(centre) + (_CORNERS * half) @ rotation.T
-
-
-def test_a_palm_box_gives_its_underside_and_several_their_deepest_rectangle():
-    from contourgrasp.sim.model_hand import _palm_plate
-
-    flat = _palm_plate(box_corners([0.0, 0.0, -0.01], [0.05, 0.04, 0.01]))  # underside at z = 0
-    assert flat.depths is None and flat.thickness == pytest.approx(0.02)
-    assert sorted(flat.outline) == sorted([(-0.05, -0.04), (-0.05, 0.04), (0.05, -0.04), (0.05, 0.04)])
-    tilted = _palm_plate(box_corners([0.0, 0.0, 0.0], [0.06, 0.04, 0.01], turn=0.3))
-    # the broad face toward +z, tilted by 0.3 rad: its z rises along x by tan(0.3)
-    a, b, c = tilted.plane
-    assert b == pytest.approx(-np.tan(0.3), abs=1e-9) and c == pytest.approx(0.0, abs=1e-9)
-    assert a == pytest.approx(0.01 / np.cos(0.3), abs=1e-9)
-    two = _palm_plate(np.vstack([box_corners([0.0, 0.0, -0.01], [0.05, 0.04, 0.01]),
-                                 box_corners([0.08, 0.0, 0.0], [0.02, 0.02, 0.015])]))
-    assert two.depths == (0.015,) * 4 and two.points[:, 0].max() == pytest.approx(0.1)
-
-
 def test_our_simulated_hand_is_not_built_from_measured_chains():
     from contourgrasp.errors import SimulationError
 

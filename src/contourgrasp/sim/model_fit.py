@@ -4,22 +4,26 @@ Pure numpy on the paths :mod:`contourgrasp.sim.model_hand` records (its docstrin
 the model): :func:`fit_finger` fits a projected fingertip path with a ray (eq 3.18) or, when the ray
 leaves it by more than ``tolerances.MODEL_FIT_TOLERANCE``, an axis-aligned elliptic arc (eq 3.20,
 a least-squares conic); :func:`travelled` reads a path as distances along the fitted trajectory;
-:func:`fit_chain` measures a two-hinge finger's :class:`~contourgrasp.hand.FingerChain`, and
-:func:`sampled_chain` any finger's :class:`~contourgrasp.hand.SampledChain`.
+:func:`fit_chain` measures a two-hinge finger's :class:`~contourgrasp.hand.FingerChain`,
+:func:`sampled_chain` any finger's :class:`~contourgrasp.hand.SampledChain`, and :func:`palm_plate` the
+:class:`~contourgrasp.hand.Palm` from the palm geoms' boxes.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from .. import tolerances as tol
 from ..errors import HandError
-from ..hand import Arc, Finger, FingerChain, Ray, SampledChain, check_chain, polyline_distance
+from ..contour.polygon import signed_area
+from ..hand import Arc, Finger, FingerChain, Palm, Ray, SampledChain, check_chain, polyline_distance
 
 #: Default gains of a derived hand's fingers (the five-finger-linear preset's).
 ALPHA, BETA = 25.0, 10000.0
+#: The eight corners of a unit box, in the order :func:`underside_face` reads a box's corners in (x slowest).
+BOX_CORNERS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)
 
 
 @dataclass(frozen=True)
@@ -177,3 +181,40 @@ def sampled_chain(finger: Finger, tips: np.ndarray, joints: np.ndarray) -> tuple
     except HandError as err:
         return None, str(err)
     return chain, ""
+
+
+def palm_plate(corners: np.ndarray) -> Palm:
+    """The palm's plate from its collision geoms' bounding-box corners (8 per geom, hand frame).
+
+    One geom: the box's face toward the object that covers the most of the palm plane
+    (:func:`underside_face`) is the underside, tilted as the box is, and the plate is as thick as the
+    box above it. Several: their rectangle on the palm plane, its underside as deep as their deepest
+    corner (below z = 0 only) -- the palm's lowest point everywhere under it, on the safe side.
+    """
+    if len(corners) == 8:
+        face = underside_face(corners)
+        palm = Palm(outline=tuple(map(tuple, face)), thickness=tol.FINGER_MOVED)
+        above = float((np.c_[np.ones(8), corners[:, :2]] @ palm.plane - corners[:, 2]).max())
+        return replace(palm, thickness=max(above, tol.FINGER_MOVED))
+    (x0, y0, z0), (x1, y1, z1) = corners.min(axis=0), corners.max(axis=0)
+    depth = max(float(z1), 0.0)
+    return Palm(outline=((x0, y0), (x1, y0), (x1, y1), (x0, y1)), thickness=max(depth - float(z0), tol.FINGER_MOVED),
+                depths=(depth,) * 4)
+
+
+def underside_face(box: np.ndarray) -> np.ndarray:
+    """(4, 3) float: the corners, in order around it, of the face of a box (its 8 corners in :data:`BOX_CORNERS`'s
+    order) that faces the object (outward normal with +z) and covers the most of the palm plane."""
+    centre = box.mean(axis=0)
+    best, face = -np.inf, None
+    for axis in range(3):
+        others = [a for a in range(3) if a != axis]
+        for side in (0, 1):
+            index = [sum(b << (2 - a) for a, b in zip([axis, *others], (side, *pair), strict=True))
+                     for pair in ((0, 0), (1, 0), (1, 1), (0, 1))]
+            if box[index].mean(axis=0)[2] <= centre[2]:
+                continue
+            shadow = abs(signed_area(box[index, :2]))
+            if shadow > best:
+                best, face = shadow, box[index]
+    return face

@@ -51,7 +51,7 @@ joint to tip, its open and closed joint angles measured in the chain's plane, wh
 plane) is given its chain as measured, a :class:`~contourgrasp.hand.SampledChain`: its hinges'
 anchors and its tip along the recorded closing (:func:`~contourgrasp.sim.model_fit.sampled_chain`),
 every link a capsule of the finger's radius (a bounding capsule of each link's geoms was tried and
-refused too much: README, "The bench on the models"). The palm (:func:`_palm_plate`): one collision
+refused too much: README, "The bench on the models"). The palm (:func:`~contourgrasp.sim.model_fit.palm_plate`): one collision
 geom's box gives its tilted underside face; several give their rectangle, as deep as their deepest
 corner. The hand keeps its chains and palm only when every finger has a chain; otherwise it is a 2-D
 hand, and :attr:`Derivation.notes` says why. Finger radius: half the smallest extent of the
@@ -75,11 +75,11 @@ os.environ.setdefault("MUJOCO_GL", "disable")
 import mujoco  # noqa: E402
 
 from .. import tolerances as tol  # noqa: E402
-from ..contour.polygon import signed_area  # noqa: E402
 from ..errors import HandError, HandFileError, SimulationError  # noqa: E402
 from ..hand import Hand, Palm, SampledChain  # noqa: E402
 from .calibrate import Closing, derive_virtual_starts  # noqa: E402
-from .model_fit import FingerFit, fit_chain, fit_finger, sampled_chain, travelled  # noqa: E402
+from .model_fit import (BOX_CORNERS, FingerFit, fit_chain, fit_finger, palm_plate, sampled_chain,  # noqa: E402
+                        travelled)
 from .scene import TIMESTEP, mujoco_warnings  # noqa: E402
 
 #: Time the open hand settles before closing, s.
@@ -383,7 +383,7 @@ def close_model(spec: ModelSpec, *, close_time: float = 1.0, hold_time: float = 
                        tips=tips_hand, mount=mount,
                        joints=tuple(np.transpose(j, (1, 0, 2)) @ axes.T - shift for j in joint_records),
                        radius=np.array([_tip_radius(m, t, collides) for t in tips]),
-                       palm=None if palm_geoms is None else _palm_plate(palm_geoms - shift))
+                       palm=None if palm_geoms is None else palm_plate(palm_geoms - shift))
 
 
 def _finger_bodies(m, palm: int, tips) -> tuple[tuple[str, int], ...]:
@@ -597,13 +597,9 @@ def _hand_axes(pointing: np.ndarray) -> np.ndarray:
     return np.stack([x, np.cross(z, x), z])
 
 
-#: The eight corners of a unit box, for the geoms' local bounding boxes.
-_CORNERS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], dtype=float)
-
-
 def _local_corners(m, g: int) -> np.ndarray:
     """(8, 3) float: the corners of geom ``g``'s bounding box in its own frame."""
-    return m.geom_aabb[g, :3] + _CORNERS * m.geom_aabb[g, 3:]
+    return m.geom_aabb[g, :3] + BOX_CORNERS * m.geom_aabb[g, 3:]
 
 
 def _geom_corners(m, d, geoms, origin: np.ndarray, rotation: np.ndarray) -> np.ndarray:
@@ -621,43 +617,6 @@ def _palm_geoms(m, d, palm: int, subtree: set[int], axes: np.ndarray, collides: 
         return None
     rotation = d.xmat[palm].reshape(3, 3)
     return _geom_corners(m, d, geoms, d.xpos[palm], rotation) @ axes.T
-
-
-def _palm_plate(corners: np.ndarray) -> Palm:
-    """The palm's plate from its collision geoms' bounding-box corners (8 per geom, hand frame).
-
-    One geom: the box's face toward the object that covers the most of the palm plane
-    (:func:`_underside_face`) is the underside, tilted as the box is, and the plate is as thick as the
-    box above it. Several: their rectangle on the palm plane, its underside as deep as their deepest
-    corner (below z = 0 only) -- the palm's lowest point everywhere under it, on the safe side.
-    """
-    if len(corners) == 8:
-        face = _underside_face(corners)
-        palm = Palm(outline=tuple(map(tuple, face)), thickness=tol.FINGER_MOVED)
-        above = float((np.c_[np.ones(8), corners[:, :2]] @ palm.plane - corners[:, 2]).max())
-        return replace(palm, thickness=max(above, tol.FINGER_MOVED))
-    (x0, y0, z0), (x1, y1, z1) = corners.min(axis=0), corners.max(axis=0)
-    depth = max(float(z1), 0.0)
-    return Palm(outline=((x0, y0), (x1, y0), (x1, y1), (x0, y1)), thickness=max(depth - float(z0), tol.FINGER_MOVED),
-                depths=(depth,) * 4)
-
-
-def _underside_face(box: np.ndarray) -> np.ndarray:
-    """(4, 3) float: the corners, in order around it, of the face of a box (its 8 corners in :data:`_CORNERS`'s
-    order) that faces the object (outward normal with +z) and covers the most of the palm plane."""
-    centre = box.mean(axis=0)
-    best, face = -np.inf, None
-    for axis in range(3):
-        others = [a for a in range(3) if a != axis]
-        for side in (0, 1):
-            index = [sum(b << (2 - a) for a, b in zip([axis, *others], (side, *pair), strict=True))
-                     for pair in ((0, 0), (1, 0), (1, 1), (0, 1))]
-            if box[index].mean(axis=0)[2] <= centre[2]:
-                continue
-            shadow = abs(signed_area(box[index, :2]))
-            if shadow > best:
-                best, face = shadow, box[index]
-    return face
 
 
 def _tip_radius(m, tip: tuple[str, int], collides: np.ndarray) -> float:
