@@ -71,6 +71,7 @@ import numpy as np
 
 from . import tolerances as tol
 from . import validation as check
+from ._quality_kernels import ball_radii
 from .contour import EFD, evaluate
 from .errors import QualityError
 
@@ -377,26 +378,11 @@ def _ball_radius_batch(w: np.ndarray, ok: np.ndarray) -> np.ndarray:
     does not have.
     """
     g, m, _ = w.shape
-    out = np.zeros(g)
     if m < 4:
-        return out
-    i, j, k = _triples(m)
-    chunk = max(1, tol.WRENCH_BATCH_ELEMENTS // (len(i) * m))
-    for s in range(0, g, chunk):
-        ws, oks = w[s : s + chunk], ok[s : s + chunk]
-        a = ws[:, i]
-        normal = np.cross(ws[:, j] - a, ws[:, k] - a)
-        length = np.linalg.norm(normal, axis=-1)
-        usable = oks[:, i] & oks[:, j] & oks[:, k] & (length > tol.WRENCH_PLANE)
-        unit = normal / np.where(usable, length, 1.0)[..., None]
-        h = np.einsum("gtd,gtd->gt", unit, a)  # the plane is unit . x = h
-        side = np.einsum("gtd,gmd->gtm", unit, ws) - h[..., None]
-        side = np.where(oks[:, None, :], side, 0.0)
-        below = usable & np.all(side <= tol.WRENCH_ZERO, axis=-1)  # outward normal +unit
-        above = usable & np.all(side >= -tol.WRENCH_ZERO, axis=-1)  # outward normal -unit
-        dist = np.minimum(np.where(below, h, np.inf), np.where(above, -h, np.inf)).min(axis=1)
-        out[s : s + chunk] = np.where(np.isfinite(dist) & (dist > tol.WRENCH_ZERO), dist, 0.0)
-    return out
+        return np.zeros(g)
+    dist = ball_radii(np.ascontiguousarray(w), np.ascontiguousarray(ok), *_triples(m),
+                      tol.WRENCH_PLANE, tol.WRENCH_ZERO)
+    return np.where(np.isfinite(dist) & (dist > tol.WRENCH_ZERO), dist, 0.0)
 
 
 @functools.lru_cache(maxsize=32)

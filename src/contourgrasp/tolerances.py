@@ -320,9 +320,6 @@ MAX_GAIN = 1e9
 #: many contacts it is refused.
 LINF_MAX_CONTACTS = 8
 
-#: Elements of the (poses, planes, wrenches) array quality.epsilon_many evaluates at once.
-WRENCH_BATCH_ELEMENTS = 2_000_000
-
 #: Most fingers of a hand: every array of the search has one column per finger (about 65 bytes per
 #: pose and finger on the grid), and no hand the planner is meant for has more fingertips.
 MAX_FINGERS = 10
