@@ -210,13 +210,15 @@ def _search_outline(contour, *, hand: Hand, grid: SearchGrid, safeguards: Safegu
         attempts += [(touching, replace(safeguards, max_imbalance=1.0)) for touching in counts]
     screen = screen_grid(model, replace(hand, min_touching=fewest), grid, curvature=curvature)
     touch_counts = np.count_nonzero(screen.touching, axis=1)
+    share = np.full(len(screen.poses), np.nan)  # the squeeze's balance per screened pose, filled as attempts need it
     searched = time.perf_counter()
     errors = []
     for touching, guards in attempts:
         try:
             plan = _search_fitted(model, contour, replace(hand, min_touching=touching),
                                   _needing(screen, touch_counts, touching), grid, guards, descent,
-                                  curvature=curvature, top_k=top_k, refine=refine, times=(clock, fitted, searched))
+                                  curvature=curvature, top_k=top_k, refine=refine, times=(clock, fitted, searched),
+                                  share=share)
         except NoFeasibleGrasp as err:
             errors.append(err)  # its reason worked out only if every attempt fails (_Unexplained)
             continue
@@ -273,17 +275,17 @@ def _needing(screen: PoseEvaluation, counts: np.ndarray, touching: int) -> PoseE
 
 def _search_fitted(model: EFD, contour, hand: Hand, screen: PoseEvaluation, grid: SearchGrid,
                    safeguards: Safeguards, descent: Descent | None, *, curvature, top_k, refine,
-                   times) -> GraspPlan:
+                   times, share) -> GraspPlan:
     """:func:`search` for one ``hand.min_touching`` on a fitted model and its screened grid.
 
     ``times``: the clock at the search's start, after the fit and after the screen (``timing_ms``'s
-    ``exact`` includes earlier counts' exact evaluations).
+    ``exact`` includes earlier counts' exact evaluations). ``share``: see :func:`_screened_share`.
     """
     clock, fitted, searched = times
     if not screen.feasible.any():
         raise _no_pose(screen, hand, grid)
     result = _reevaluate_best(model, hand, screen, max(tol.REFINE_CANDIDATES, 4 * top_k), curvature, grid.d_min,
-                              safeguards, descent)
+                              safeguards, descent, share)
     ranked = distinct_best(result, grid, top_k)
     exact = time.perf_counter()
     refinement, refined_at = None, exact
@@ -342,16 +344,18 @@ def _check_harmonics(harmonics) -> None:
 
 
 def _reevaluate_best(model, hand, screen: PoseEvaluation, n: int, curvature, d_min,
-                     safeguards: Safeguards, descent: Descent | None = None) -> PoseEvaluation:
+                     safeguards: Safeguards, descent: Descent | None = None, share=None) -> PoseEvaluation:
     """Exact evaluation of the n cheapest screened poses, then 4n, 16n, ... until one is feasible.
 
     With ``descent``, feasible also means the open hand descends clear (checked in increasing cost,
     each pose once, at most ``tolerances.MAX_DESCENT_POSES`` in all). With the squeeze's balance, only
-    poses whose screened contacts balance within ``tolerances.IMBALANCE_SCREEN`` of it are evaluated.
+    poses whose screened contacts balance within ``tolerances.IMBALANCE_SCREEN`` of it are evaluated
+    (``share``: see :func:`_screened_share`; default none known).
     """
     feasible = np.flatnonzero(screen.feasible)
     if safeguards.balances:  # screened on the polygon's contacts: the exact check below decides
-        share = grasp_imbalance(model, screen.t[feasible], screen.touching[feasible])
+        known = np.full(len(screen.poses), np.nan) if share is None else share
+        share = _screened_share(model, screen, known, feasible)
         near = share <= safeguards.max_imbalance + tol.IMBALANCE_SCREEN
         if not near.any():
             raise NoFeasibleGrasp(_unbalanced(len(feasible), float(share.min(initial=1.0)), safeguards))
@@ -376,6 +380,18 @@ def _reevaluate_best(model, hand, screen: PoseEvaluation, n: int, curvature, d_m
                 raise _Unexplained(partial(_diagnose_descent, hand, last, descended, descent))
             raise NoFeasibleGrasp(_diagnose_exact(result, safeguards))
         n *= 4
+
+
+def _screened_share(model, screen: PoseEvaluation, share: np.ndarray, poses: np.ndarray) -> np.ndarray:
+    """The squeeze's imbalance of the screened poses ``poses`` (indices) on their polygon contacts.
+
+    ``share`` (one per screened pose, NaN where not yet known) is filled in where missing: one
+    screen serves every attempt of a search, each on a subset of its poses, so each pose's share
+    is computed once.
+    """
+    missing = poses[np.isnan(share[poses])]
+    share[missing] = grasp_imbalance(model, screen.t[missing], screen.touching[missing])
+    return share[poses]
 
 
 class _Unexplained(NoFeasibleGrasp):
