@@ -314,6 +314,10 @@ def test_hand_from_model_writes_a_hand_that_plans(tmp_path, capsys, model):
                          tmp_path / "plan.json")
     assert code == 0, err
     assert json.loads((tmp_path / "plan.json").read_text())["hand"] == model
+    brushing = "tips_brush_table = true" in hand.read_text()
+    assert brushing == (model == "inspire")  # the bundled models' own, chosen on the bench
+    code, _, err = run(capsys, "hand-from-model", model, "--out", hand, "--no-tips-brush-table")
+    assert code == 0 and "tips_brush_table = false" in hand.read_text(), err
 
 
 def test_hand_from_model_bad_input_is_one_line_and_writes_nothing(tmp_path, capsys):

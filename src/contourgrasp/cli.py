@@ -301,6 +301,10 @@ def _add_hand_from_model_parser(sub) -> None:
     derive.add_argument("--max-imbalance", type=_non_negative_float, metavar="SHARE",
                         help="the hand's own squeeze balance, 0..1 (a planner's max_imbalance 'hand'; default: the "
                              "bundled model's, else 0.25); closing in free air cannot measure it")
+    derive.add_argument("--tips-brush-table", action=argparse.BooleanOptionalAction, default=None,
+                        help="plan the open fingertips just above the table, a finger swinging lower as it closes "
+                             "brushing it (default: the bundled model's, else not); chosen on the bench, as the "
+                             "balance is")
     derive.add_argument("--out", required=True, help="the hand TOML to write")
 
 
@@ -573,7 +577,8 @@ def _hand_from_model(args) -> int:
     from .sim.model_hand import derive_hand, fit_table
 
     derivation = derive_hand(args.model, fingertips=args.fingertips, actuators=args.actuators, palm=args.palm,
-                             approach=args.approach, max_imbalance=args.max_imbalance)
+                             approach=args.approach, max_imbalance=args.max_imbalance,
+                             tips_brush_table=args.tips_brush_table)
     print("\n".join(fit_table(derivation)))
     comment = "\n".join([f"Derived by `contourgrasp hand-from-model` from {Path(args.model).name}: fit errors (mm)",
                           *(f"  {fit.name}: {fit.kind} {1000 * fit.error:.2f}" for fit in derivation.fits),

@@ -54,6 +54,7 @@ def test_a_hand_file_plans_grasps(tmp_path):
         (("closing_direction = [1.0, 0.0]", "closing_direction = [1.0, 0.0]\narc = {a_cos = 0.05, a_sin = 0.04, phi_off = 0.0}", 1), "exactly one of"),
         (("beta = 1000.0", "beta = -1.0", 1), r"beta: Input should be greater than or equal to 0"),
         (("[[fingers]]", "[[fingers", 1), "not valid TOML"),
+        (("min_touching = 2", "min_touching = 2\ntips_brush_table = 1", 1), r"tips_brush_table: Input should be a valid boolean"),
     ],
 )
 def test_hand_file_errors_name_the_file_and_the_field(tmp_path, edit, message):
@@ -90,8 +91,8 @@ def test_presets_have_the_table_values():
 def test_hand_to_toml_round_trips(name):
     hand = load_hand(name)
     again = parse_hand(hand_to_toml(hand, comment="a\nb"))
-    assert (again.name, again.min_touching, again.miss_penalty, again.max_imbalance) == (
-        hand.name, hand.min_touching, hand.miss_penalty, hand.max_imbalance)
+    assert (again.name, again.min_touching, again.miss_penalty, again.max_imbalance, again.tips_brush_table) == (
+        hand.name, hand.min_touching, hand.miss_penalty, hand.max_imbalance, hand.tips_brush_table)
     for f, g in zip(hand.fingers, again.fingers, strict=True):
         assert (g.name, g.start, g.travel, g.virtual_start, g.alpha, g.beta, g.required) == (
             f.name, f.start, f.travel, f.virtual_start, f.alpha, f.beta, f.required)

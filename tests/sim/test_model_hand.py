@@ -141,12 +141,14 @@ def test_the_inspire_palm_is_its_box_tilted_underside():
     assert min(palm.depths) < -0.02 and max(palm.depths) > 0.05
 
 
-def test_a_derived_hand_carries_the_models_squeeze_balance(sliders):
-    # closing in free air cannot measure it: the bundled Jaco's is chosen on the bench, a file's is the default
-    assert derive_hand("jaco-three-finger").hand.max_imbalance == 1.0
-    assert derive_hand("inspire").hand.max_imbalance == tol.HAND_MAX_IMBALANCE
-    mine = derive_hand(sliders, fingertips=["left_tip", "right_tip"], max_imbalance=0.5).hand
-    assert mine.max_imbalance == 0.5
+def test_a_derived_hand_carries_the_models_squeeze_balance_and_table_brushing(sliders):
+    # closing in free air cannot measure them: the bundled models' are chosen on the bench, a file's are the defaults
+    jaco, inspire = derive_hand("jaco-three-finger").hand, derive_hand("inspire").hand
+    assert (jaco.max_imbalance, jaco.tips_brush_table) == (1.0, False)
+    assert (inspire.max_imbalance, inspire.tips_brush_table) == (tol.HAND_MAX_IMBALANCE, True)
+    assert not derive_hand(sliders, fingertips=["left_tip", "right_tip"]).hand.tips_brush_table
+    mine = derive_hand(sliders, fingertips=["left_tip", "right_tip"], max_imbalance=0.5, tips_brush_table=True).hand
+    assert (mine.max_imbalance, mine.tips_brush_table) == (0.5, True)
     with pytest.raises(HandError, match="max_imbalance must be at most 1"):
         derive_hand(sliders, fingertips=["left_tip", "right_tip"], max_imbalance=2.0)
 

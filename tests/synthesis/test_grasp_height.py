@@ -1,5 +1,7 @@
 """The grasp height rules against the hand's geometry."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -34,11 +36,25 @@ def test_clearance_keeps_the_palm_above_a_tall_objects_top(hand):
 
 
 def test_auto_asks_a_fraction_of_the_height_and_accepts_up_to_a_larger_one(hand):
-    floor, _ = grasp_height(hand, with_top(0.02), "clearance")
-    assert grasp_height(hand, with_top(0.02), "auto") == pytest.approx((floor, floor))
-    low, high = grasp_height(hand, with_top(0.10), "auto")
-    assert low == pytest.approx(tol.GRASP_HEIGHT_FRACTION * 0.10)
-    assert high == pytest.approx(tol.MAX_GRASP_HEIGHT_FRACTION * 0.10)
+    stiff = replace(hand, tips_brush_table=False)
+    floor, _ = grasp_height(stiff, with_top(0.02), "clearance")
+    assert grasp_height(stiff, with_top(0.02), "auto") == pytest.approx((floor, floor))
+    for h in (hand, stiff):
+        low, high = grasp_height(h, with_top(0.10), "auto")
+        assert low == pytest.approx(tol.GRASP_HEIGHT_FRACTION * 0.10)
+        assert high == pytest.approx(tol.MAX_GRASP_HEIGHT_FRACTION * 0.10)
+
+
+def test_tips_brushing_the_table_are_asked_just_above_it_and_may_rise_to_clear_it(hand):
+    assert hand.tips_brush_table
+    swing = hand.closing_tip_depth - hand.open_tip_depth
+    open_floor = max(c.radius for c in hand.chains) + tol.GRASP_TIP_CLEARANCE
+    low, high = grasp_height(hand, with_top(0.02), "auto")
+    assert low == pytest.approx(open_floor)  # 20 mm: 0.4 of it is below the open tips' floor
+    assert high == pytest.approx(open_floor + swing) == grasp_height(hand, with_top(0.02), "clearance")[0]
+    # between the floors the fraction decides, as without brushing
+    top = (open_floor + 0.5 * swing) / tol.GRASP_HEIGHT_FRACTION
+    assert grasp_height(hand, with_top(top), "auto")[0] == pytest.approx(open_floor + 0.5 * swing)
 
 
 def test_a_number_is_the_height_itself_and_bad_rules_are_refused(hand):

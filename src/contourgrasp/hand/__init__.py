@@ -63,7 +63,13 @@ class Hand:
         driven, which no trajectory shows: a tendon hand is pushed off an unbalanced squeeze, fingers
         holding their own positions stop the object against the others. Default
         ``tolerances.HAND_MAX_IMBALANCE``.
-    description : str
+    tips_brush_table : bool
+        For a 3-D hand, the grasp height the planner asks for
+        (:func:`~contourgrasp.synthesis.grasp_height`, rule ``"auto"``): True, the open fingertips
+        just above the table, so a finger that swings lower as it closes may brush it; False (the
+        default), high enough that no closing fingertip reaches it. Whether a hand grasps low
+        objects better brushing the table depends on how its fingers give way and curl on them,
+        which no trajectory shows, so it is chosen on the bench, as ``max_imbalance`` is.
     chains : tuple of FingerChain or SampledChain, optional
         The fingers' bodies, one per finger in the order of ``fingers``; None (the default) for a
         2-D hand. Given together with ``palm``.
@@ -73,8 +79,8 @@ class Hand:
     ------
     HandError
         No fingers or more than ``tolerances.MAX_FINGERS``, a finger that is not a :class:`Finger`, names not unique, ``min_touching``
-        not in 1..number of fingers, ``miss_penalty`` not in [0, ``tolerances.MAX_GAIN``] or ``max_imbalance``
-        not in [0, 1];
+        not in 1..number of fingers, ``miss_penalty`` not in [0, ``tolerances.MAX_GAIN``], ``max_imbalance``
+        not in [0, 1] or ``tips_brush_table`` not a bool;
         chains without a palm or the reverse, not one chain per finger, or a chain that does not
         realise its finger's trajectory (:func:`check_chain`, naming the finger).
     """
@@ -84,6 +90,7 @@ class Hand:
     min_touching: int
     miss_penalty: float = 250.0
     max_imbalance: float = tol.HAND_MAX_IMBALANCE
+    tips_brush_table: bool = False
     description: str = field(default="", compare=False)
     chains: tuple[FingerChain | SampledChain, ...] | None = None
     palm: Palm | None = None
@@ -104,6 +111,9 @@ class Hand:
         check.bounded(f"hand {self.name!r}: miss_penalty", self.miss_penalty, tol.MAX_GAIN, error=HandError)
         share = check.bounded(f"hand {self.name!r}: max_imbalance", self.max_imbalance, 1.0, "", error=HandError)
         object.__setattr__(self, "max_imbalance", share)
+        if not isinstance(self.tips_brush_table, (bool, np.bool_)):
+            raise HandError(f"hand {self.name!r}: tips_brush_table must be true or false, got {self.tips_brush_table!r}")
+        object.__setattr__(self, "tips_brush_table", bool(self.tips_brush_table))
         if len({f.name for f in self.fingers}) != n:
             raise HandError(f"hand {self.name!r}: finger names must be unique")
         self._check_body()

@@ -11,6 +11,10 @@ Schema (all lengths in meters, angles in radians)::
     max_imbalance = 0.25             # optional, 0..1: the squeeze's balance the hand is planned
                                      # with by a planner asking for the hand's (default's
                                      # max_imbalance = "hand"); default 0.25; 1: off
+    tips_brush_table = true          # optional, 3-D hands: the planned grasp height ("auto")
+                                     # asks for the open fingertips just above the table, a
+                                     # finger swinging lower as it closes may brush it;
+                                     # default false: no closing fingertip reaches it
 
     [[fingers]]                      # one table per finger, at least one
     name = "thumb"
@@ -164,6 +168,7 @@ class _HandSchema(_Strict):
     min_touching: int = Field(ge=1)
     miss_penalty: Gain | None = None
     max_imbalance: Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] = tol.HAND_MAX_IMBALANCE
+    tips_brush_table: bool = False
     fingers: list[_FingerSchema] = Field(min_length=1, max_length=tol.MAX_FINGERS)
     palm: _PalmSchema | None = None
 
@@ -225,6 +230,7 @@ def parse_hand(text: str, *, source: str = "<string>") -> Hand:
             min_touching=schema.min_touching,
             miss_penalty=_miss_penalty(schema),
             max_imbalance=schema.max_imbalance,
+            tips_brush_table=schema.tips_brush_table,
             description=schema.description,
             chains=chains,
             palm=palm,
@@ -303,7 +309,8 @@ def hand_to_toml(hand: Hand, *, comment: str = "") -> str:
     lines = [f"# {line}".rstrip() for line in comment.splitlines()]
     lines += [f"name = {_string(hand.name)}", f"description = {_string(hand.description)}",
               f"min_touching = {hand.min_touching}", f"miss_penalty = {_float(hand.miss_penalty)}",
-              f"max_imbalance = {_float(hand.max_imbalance)}"]
+              f"max_imbalance = {_float(hand.max_imbalance)}",
+              f"tips_brush_table = {'true' if hand.tips_brush_table else 'false'}"]
     for f in hand.fingers:
         lines += ["", "[[fingers]]", f"name = {_string(f.name)}", f"start = {_floats(f.start)}"]
         if isinstance(f.trajectory, Ray):

@@ -18,10 +18,15 @@ a pose whose open hand cannot descend that low stops as high as its bodies need,
     underside itself above the object, pose by pose (chosen on the training objects with the Inspire
     model: README, "The bench on the models").
 ``"auto"``
-    The same height asked for, raised where the bodies need it up to
-    ``tolerances.GRASP_HEIGHT_FRACTION`` of the object's height: the tips still close on its lower
-    part, below its widest part for most objects lying or standing on a table. Chosen on the
-    ``ycb-train`` objects (README, "3-D hand").
+    The same height asked for, at least ``tolerances.GRASP_HEIGHT_FRACTION`` of the object's
+    height, raised where the bodies need it up to ``tolerances.MAX_GRASP_HEIGHT_FRACTION`` of it:
+    the tips still close on its lower part, below its widest part for most objects lying or
+    standing on a table. Chosen on the ``ycb-train`` objects (README, "3-D hand"). A hand whose
+    fingertips brush the table (:attr:`Hand.tips_brush_table`) is asked for its open tips just
+    above the table, its radius plus ``tolerances.GRASP_TIP_CLEARANCE``, without the swing of a
+    leaning finger that dips lower as it closes; it may still be raised to the height where no
+    closing tip reaches the table. That lowers the grasp on objects lower than about 2.5 times
+    that height, where the fraction does not decide it.
 """
 
 from __future__ import annotations
@@ -81,10 +86,11 @@ def grasp_height(hand: Hand, heights: HeightMap, rule: str | float = "auto") -> 
             raise NoFeasibleGrasp(f"a grasp height of {1000 * rule:.0f} mm is not below the object's top "
                                   f"({1000 * top:.0f} mm): the fingertips would close over it")
         return rule, rule
-    swing = hand.closing_tip_depth - hand.open_tip_depth
-    floor = max(c.radius for c in hand.chains) + tol.GRASP_TIP_CLEARANCE + swing
-    height = max(floor, top + tol.GRASP_PALM_CLEARANCE - hand.open_tip_depth)
+    open_floor = max(c.radius for c in hand.chains) + tol.GRASP_TIP_CLEARANCE
+    palm_floor = top + tol.GRASP_PALM_CLEARANCE - hand.open_tip_depth
+    height = max(open_floor + hand.closing_tip_depth - hand.open_tip_depth, palm_floor)
     if rule == "clearance":
         return height, height
-    asked = max(height, tol.GRASP_HEIGHT_FRACTION * top)
-    return asked, max(asked, tol.MAX_GRASP_HEIGHT_FRACTION * top)
+    lowest = max(open_floor, palm_floor) if hand.tips_brush_table else height
+    asked = max(lowest, tol.GRASP_HEIGHT_FRACTION * top)
+    return asked, max(height, asked, tol.MAX_GRASP_HEIGHT_FRACTION * top)
