@@ -54,7 +54,8 @@ def test_a_hand_file_plans_grasps(tmp_path):
         (("closing_direction = [1.0, 0.0]", "closing_direction = [1.0, 0.0]\narc = {a_cos = 0.05, a_sin = 0.04, phi_off = 0.0}", 1), "exactly one of"),
         (("beta = 1000.0", "beta = -1.0", 1), r"beta: Input should be greater than or equal to 0"),
         (("[[fingers]]", "[[fingers", 1), "not valid TOML"),
-        (("min_touching = 2", "min_touching = 2\ntips_brush_table = 1", 1), r"tips_brush_table: Input should be a valid boolean"),
+        (("min_touching = 2", "min_touching = 2\ntips_brush_table = 1", 1),
+         r"tips_brush_table: Input should be a valid boolean"),
     ],
 )
 def test_hand_file_errors_name_the_file_and_the_field(tmp_path, edit, message):

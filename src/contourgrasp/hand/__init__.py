@@ -112,7 +112,8 @@ class Hand:
         share = check.bounded(f"hand {self.name!r}: max_imbalance", self.max_imbalance, 1.0, "", error=HandError)
         object.__setattr__(self, "max_imbalance", share)
         if not isinstance(self.tips_brush_table, (bool, np.bool_)):
-            raise HandError(f"hand {self.name!r}: tips_brush_table must be true or false, got {self.tips_brush_table!r}")
+            raise HandError(f"hand {self.name!r}: tips_brush_table must be true or false, "
+                            f"got {self.tips_brush_table!r}")
         object.__setattr__(self, "tips_brush_table", bool(self.tips_brush_table))
         if len({f.name for f in self.fingers}) != n:
             raise HandError(f"hand {self.name!r}: finger names must be unique")

@@ -291,7 +291,8 @@ def load_model(path) -> mujoco.MjModel:
 
 
 def derive_hand(model, *, fingertips=None, actuators=None, palm=None, approach=None, max_imbalance=None,
-                tips_brush_table=None, name: str | None = None, close_time: float = 1.0, hold_time: float = 0.5) -> Derivation:
+                tips_brush_table=None, name: str | None = None, close_time: float = 1.0,
+                hold_time: float = 0.5) -> Derivation:
     """Close a MuJoCo hand model with one synergy and fit its hand file (module docstring).
 
     Parameters

@@ -25,8 +25,8 @@ a pose whose open hand cannot descend that low stops as high as its bodies need,
     fingertips brush the table (:attr:`Hand.tips_brush_table`) is asked for its open tips just
     above the table, its radius plus ``tolerances.GRASP_TIP_CLEARANCE``, without the swing of a
     leaning finger that dips lower as it closes; it may still be raised to the height where no
-    closing tip reaches the table. That lowers the grasp on objects lower than about 2.5 times
-    that height, where the fraction does not decide it.
+    closing tip reaches the table. That lowers the grasp only on objects lower than the clearance
+    height divided by ``GRASP_HEIGHT_FRACTION`` (2.5 times it), where the fraction does not decide.
 """
 
 from __future__ import annotations
