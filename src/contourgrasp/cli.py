@@ -297,7 +297,7 @@ def _add_hand_from_model_parser(sub) -> None:
     derive.add_argument("--approach", choices=APPROACHES,
                         help="the palm body's axis toward the object; 'fingers': the axis the fingers point along (the "
                              "default for a model file); 'level': that axis turned until the first fingertip's open "
-                             "tip is as deep as the others' mean (the bundled inspire's)")
+                             "tip is as deep as the deepest other's (the bundled inspire's)")
     derive.add_argument("--max-imbalance", type=_non_negative_float, metavar="SHARE",
                         help="the hand's own squeeze balance, 0..1 (a planner's max_imbalance 'hand'; default: the "
                              "bundled model's, else 0.25); closing in free air cannot measure it")

@@ -27,9 +27,11 @@ from contourgrasp.synthesis import descent_clearance
 
 #: Clearances within this of zero (m) are not compared, per hand: the map's 2 mm cells and MuJoCo's mesh-free
 #: cylinder differ by up to a cell's half diagonal there; the Inspire's capsules (its fingertips' 6-7 mm radius)
-#: miss the bulge of its thumb's distal link and its palm box's rounded edge by up to 12 mm (measured on these
-#: poses: 3 of 69 poses called clear by more than 4 mm touched, none by more than 12 mm).
-BANDS = {"five-finger-linear": 0.004, "jaco-three-finger": 0.004, "inspire": 0.012}
+#: miss the bulge of its thumb's links and its palm box's rounded edge (measured on these poses, the thumb
+#: levelled with the deepest finger: 1 of 63 poses called clear by more than 4 mm touched, at 12.7 mm, its
+#: thumb's second collision geom (thumb_1) 2.3 mm into the can where its capsules are 22 mm clear or more;
+#: levelled with the fingers' mean, 3 of 69, none beyond 12 mm).
+BANDS = {"five-finger-linear": 0.004, "jaco-three-finger": 0.004, "inspire": 0.013}
 
 
 @pytest.fixture(scope="module", params=list(BANDS))

@@ -23,9 +23,11 @@ the object) is the :class:`ModelSpec`'s ``approach`` axis, or else the palm axis
 best aligned with the mean direction from each finger's first hinge joint (the palm's origin for a
 finger without one) to its open fingertip -- the way the fingers point; x is the first of the palm's
 axes not along z, y = z x x. The reading ``approach = "level"`` (:data:`LEVEL`) turns that frame
-about the axis normal to z and to the offset of the first fingertip's open tip from the others'
-mean, until the two are equally deep: the hand approaches tilted so that an opposed thumb shorter
-than the fingers reaches the object with them. Our reading for a humanlike hand: along the fingers,
+about the axis normal to z and to the offset of the first fingertip's open tip from the deepest of
+the others' (along z before the turn), until the two are equally deep: the hand approaches tilted
+so that an opposed thumb shorter than the fingers reaches the object with them, as low as the
+lowest finger (the grasp height counts from the lowest open tip, so a thumb levelled with the
+fingers' mean instead stood 6.4 mm higher and met low objects on their top edge). Our reading for a humanlike hand: along the fingers,
 the Inspire's open fingertips hang 134-147 mm below the palm and its thumb's 48 mm, so a descent
 that brings the fingers to the object leaves the thumb a hand's width above it; levelled, they meet
 it together (README, "The bench on the models", for what it lifts). It needs two fingers at least,
@@ -578,12 +580,12 @@ def _axis(name: str, source: str) -> np.ndarray:
 
 
 def _levelled(axes: np.ndarray, open_tips: np.ndarray, source: str) -> np.ndarray:
-    """``axes`` turned about the axis normal to z and to the first open tip's offset from the others' mean, until
-    that tip and the others' mean are equally deep (the reading :data:`LEVEL`)."""
+    """``axes`` turned about the axis normal to z and to the first open tip's offset from the deepest of the
+    others (along ``axes``' z), until the two tips are equally deep (the reading :data:`LEVEL`)."""
     if len(open_tips) < 2:
         raise HandFileError(f"{source}: approach {LEVEL!r} levels the first fingertip with the others: it needs two "
                             f"fingertips at least, got {len(open_tips)}")
-    offset = open_tips[0] - open_tips[1:].mean(axis=0)
+    offset = open_tips[0] - open_tips[1 + int(np.argmax(open_tips[1:] @ axes[2]))]
     z = axes[2] - (axes[2] @ offset) * offset / max(float(offset @ offset), 1e-18)
     if np.linalg.norm(z) < 1e-3:
         raise HandFileError(f"{source}: approach {LEVEL!r}: the first fingertip lies straight along the fingers "
