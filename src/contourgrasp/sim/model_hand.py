@@ -26,11 +26,10 @@ axes not along z, y = z x x. The reading ``approach = "level"`` (:data:`LEVEL`) 
 about the axis normal to z and to the offset of the first fingertip's open tip from the deepest of
 the others' (along z before the turn), until the two are equally deep: the hand approaches tilted
 so that an opposed thumb shorter than the fingers reaches the object with them, as low as the
-lowest finger (the grasp height counts from the lowest open tip, so a thumb levelled with the
-fingers' mean instead stood 6.4 mm higher and met low objects on their top edge). Our reading for a humanlike hand: along the fingers,
-the Inspire's open fingertips hang 134-147 mm below the palm and its thumb's 48 mm, so a descent
-that brings the fingers to the object leaves the thumb a hand's width above it; levelled, they meet
-it together (README, "The bench on the models", for what it lifts). It needs two fingers at least,
+lowest finger (the grasp height counts from the lowest open tip). Our reading for a humanlike
+hand: along the fingers, the Inspire's open fingertips hang 134-147 mm below the palm and its
+thumb's 48 mm, so a descent that brings the fingers to the object leaves the thumb a hand's width
+above it; levelled, they meet it together (README, "The bench on the models", for what it lifts). It needs two fingers at least,
 the first not straight along the approach from the others. The origin is the palm body's origin
 moved along z to the palm's underside: the largest z of the palm's own collision geoms (those of
 bodies welded to it), but no deeper than the shallowest finger's first joint (posts below the palm
