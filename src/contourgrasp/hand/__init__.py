@@ -27,6 +27,7 @@ from .chain import (
     chain_plane,
     chain_tip,
     check_chain,
+    interpolate_samples,
     link_names,
 )
 from .trajectory import (
@@ -40,7 +41,8 @@ from .trajectory import (
 )
 
 __all__ = ["Arc", "Finger", "FingerChain", "Hand", "HandSegments", "Palm", "Ray", "SampledChain", "chain_angles",
-           "chain_capsules", "chain_deviation", "chain_joints", "chain_plane", "chain_tip", "check_chain", "link_names",
+           "chain_capsules", "chain_deviation", "chain_joints", "chain_plane", "chain_tip", "check_chain",
+           "interpolate_samples", "link_names",
            "polyline_distance", "rotation", "to_image", "trajectory_polyline"]
 
 

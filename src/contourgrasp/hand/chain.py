@@ -289,7 +289,13 @@ def chain_joints(chain: FingerChain | SampledChain, s) -> np.ndarray:
 
 def _sampled_joints(chain: SampledChain, s) -> np.ndarray:
     samples = _samples(chain)
-    at = np.clip(np.atleast_1d(np.asarray(s, dtype=float)), 0.0, 1.0) * (len(samples) - 1)
+    return interpolate_samples(samples, np.clip(np.atleast_1d(np.asarray(s, dtype=float)), 0.0, 1.0)
+                               * (len(samples) - 1))
+
+
+def interpolate_samples(samples: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """(n, j, 3) float: points moving linearly between consecutive ``samples`` (m >= 2, j, 3) at fractional
+    sample indices ``at`` (n,) in [0, m - 1] -- how a :class:`SampledChain` moves between its samples."""
     k = np.minimum(np.floor(at).astype(int), len(samples) - 2)
     w = (at - k)[:, None, None]
     return (1.0 - w) * samples[k] + w * samples[k + 1]

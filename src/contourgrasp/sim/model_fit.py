@@ -18,7 +18,8 @@ import numpy as np
 from .. import tolerances as tol
 from ..errors import HandError
 from ..contour.polygon import signed_area
-from ..hand import Arc, Finger, FingerChain, Palm, Ray, SampledChain, check_chain, polyline_distance
+from ..hand import (Arc, Finger, FingerChain, Palm, Ray, SampledChain, check_chain, interpolate_samples,
+                    polyline_distance)
 
 #: Default gains of a derived hand's fingers (the five-finger-linear preset's).
 ALPHA, BETA = 25.0, 10000.0
@@ -172,9 +173,7 @@ def sampled_chain(finger: Finger, tips: np.ndarray, joints: np.ndarray) -> tuple
     steps = np.linalg.norm(np.diff(np.asarray(tips)[:, :2], axis=0), axis=1)
     progress, first = np.unique(np.r_[0.0, np.cumsum(steps)], return_index=True)  # a still tip's repeats dropped
     at = np.interp(np.linspace(0.0, progress[-1], tol.MODEL_CHAIN_SAMPLES), progress, first.astype(float))
-    k = np.minimum(np.floor(at).astype(int), len(points) - 2)
-    w = (at - k)[:, None, None]
-    resampled = np.round((1.0 - w) * points[k] + w * points[k + 1], 6)
+    resampled = np.round(interpolate_samples(points, at), 6)
     try:
         chain = SampledChain(joints=resampled, radius=finger.radius)
         check_chain(finger, chain)

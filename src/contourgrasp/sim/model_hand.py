@@ -29,12 +29,13 @@ so that an opposed thumb shorter than the fingers reaches the object with them, 
 lowest finger (the grasp height counts from the lowest open tip). Our reading for a humanlike
 hand: along the fingers, the Inspire's open fingertips hang 134-147 mm below the palm and its
 thumb's 48 mm, so a descent that brings the fingers to the object leaves the thumb a hand's width
-above it; levelled, they meet it together (README, "The bench on the models", for what it lifts). It needs two fingers at least,
-the first not straight along the approach from the others. The origin is the palm body's origin
-moved along z to the palm's underside: the largest z of the palm's own collision geoms (those of
-bodies welded to it), but no deeper than the shallowest finger's first joint (posts below the palm
-carry knuckles), so z = 0 is the plane of the palm's underside as in :mod:`contourgrasp.hand`; the
-palm plane is the plane z = 0, and the fingertips' paths are projected on it along z.
+above it; levelled, they meet it together (README, "The bench on the models", for what it lifts).
+It needs two fingers at least, the first not straight along the approach from the others. The origin
+is the palm body's origin moved along z to the palm's underside: the largest z of the palm's own
+collision geoms (those of bodies welded to it), but no deeper than the shallowest finger's first
+joint (posts below the palm carry knuckles), so z = 0 is the plane of the palm's underside as in
+:mod:`contourgrasp.hand`; the palm plane is the plane z = 0, and the fingertips' paths are projected
+on it along z.
 
 *Trajectories.* Each fingertip's path, projected on the palm plane, is fitted by a ray (eq 3.18:
 start the open tip, direction and travel to the closed tip) and, when the ray leaves the path by more
@@ -52,10 +53,11 @@ joint to tip, its open and closed joint angles measured in the chain's plane, wh
 plane) is given its chain as measured, a :class:`~contourgrasp.hand.SampledChain`: its hinges'
 anchors and its tip along the recorded closing (:func:`~contourgrasp.sim.model_fit.sampled_chain`),
 every link a capsule of the finger's radius (a bounding capsule of each link's geoms was tried and
-refused too much: README, "The bench on the models"). The palm (:func:`~contourgrasp.sim.model_fit.palm_plate`): one collision
-geom's box gives its tilted underside face; several give their rectangle, as deep as their deepest
-corner. The hand keeps its chains and palm only when every finger has a chain; otherwise it is a 2-D
-hand, and :attr:`Derivation.notes` says why. Finger radius: half the smallest extent of the
+refused too much: README, "The bench on the models"). The palm
+(:func:`~contourgrasp.sim.model_fit.palm_plate`): one collision geom's box gives its tilted
+underside face; several give their rectangle, as deep as their deepest corner. The hand keeps
+its chains and palm only when every finger has a chain; otherwise it is a 2-D hand, and
+:attr:`Derivation.notes` says why. Finger radius: half the smallest extent of the
 fingertip body's collision geoms.
 
 *Gains.* The model says nothing about the planner's gains: every finger gets ``alpha`` 25 and
