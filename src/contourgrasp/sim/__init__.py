@@ -27,7 +27,7 @@ Example::
 from .hand_model import TIMINGS, ChainRule, FingerTiming, HandDesign, HandModel, build_hand, derive_body
 from .measure import fingertip_path_error, fingertip_paths
 from .model_fit import FingerFit, fit_finger
-from .model_hand import MODELS, Derivation, ModelSpec, derive_hand
+from .model_hand import MODELS, Derivation, ModelSpec, derive_hand, fingertip_forces
 from .model_mount import MountedHand, mount_model
 from .objects import THESIS_OBJECTS, ObjectSpec, Part, mesh_object, object_spec
 from .render import BIN_LABEL, DepthNoise, object_truth, render, render_view, tilted_view, truth_labels
@@ -39,7 +39,7 @@ from .trial import (DROPPED, FAILURE_CAUSES, HIT, NO_PLAN, PUSHED, SLIPPED, STRU
 
 __all__ = [
     "Arrangement", "BIN_LABEL", "Bin", "HIT", "SCENE_KINDS", "arrange", "build_clutter", "target_pixel", "truth_labels",
-    "Camera", "ChainRule", "Derivation", "FingerFit", "MODELS", "ModelSpec", "derive_hand", "fit_finger", "MountedHand",
+    "Camera", "ChainRule", "Derivation", "FingerFit", "MODELS", "ModelSpec", "derive_hand", "fingertip_forces", "fit_finger", "MountedHand",
     "mount_model", "DROPPED", "DepthNoise", "Execution", "FAILURE_CAUSES", "FingerTiming", "GraspOutcome", "HandDesign",
     "HandModel", "Intrinsics", "NO_PLAN", "ObjectSpec", "PUSHED", "Part", "Placement", "SLIPPED", "SR300", "STRUCK",
     "Scene", "THESIS_OBJECTS", "TIMINGS", "TrialRecord", "Workspace", "build_hand", "build_scene", "derive_body", "execute_grasp",

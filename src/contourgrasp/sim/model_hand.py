@@ -67,6 +67,7 @@ for up to three fingers, all but one beyond.
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass, replace
 from importlib import resources
@@ -78,6 +79,7 @@ os.environ.setdefault("MUJOCO_GL", "disable")
 import mujoco  # noqa: E402
 
 from .. import tolerances as tol  # noqa: E402
+from .. import validation  # noqa: E402
 from ..errors import HandError, HandFileError, SimulationError  # noqa: E402
 from ..hand import Hand, Palm, SampledChain  # noqa: E402
 from .calibrate import Closing, derive_virtual_starts  # noqa: E402
@@ -93,6 +95,8 @@ MISS_PENALTY = 250.0
 LEVEL = "level"
 #: The approach reading along the fingers (a ModelSpec's None), to override a bundled model's.
 ALONG_FINGERS = "fingers"
+#: Where along the synergy's ramp :func:`fingertip_forces` reads the forces by default.
+FORCE_PROGRESS = (0.4, 0.6, 0.8)
 
 
 @dataclass(frozen=True)
@@ -350,23 +354,11 @@ def close_model(spec: ModelSpec, *, close_time: float = 1.0, hold_time: float = 
     """Load, fix the palm, close the synergy in free air and record the fingertips (module docstring)."""
     source = spec.path
     m = load_model(source)
-    m.opt.gravity[:] = 0.0
-    m.opt.timestep, m.opt.integrator = TIMESTEP, mujoco.mjtIntegrator.mjINT_IMPLICITFAST  # the scene's
     collides = (m.geom_contype != 0) | (m.geom_conaffinity != 0)
-    m.geom_contype[:] = m.geom_conaffinity[:] = 0  # free air: nothing to touch, fingers pass each other (as in the scene)
-    palm = _palm_body(m, spec, source)
+    run, acts, held = _free_air(m, spec, close_time, hold_time)
+    palm, tips, chains = run.palm, run.tips, run.chains
     subtree = _subtree(m, palm)
-    tips = [_fingertip(m, name, subtree, source) for name in spec.fingertips]
-    acts = _actuators(m, spec.actuators, subtree, source)
-    held = _held(m, spec, subtree, source)
-    chains = [_moving_path(m, tip, palm) for tip in tips]
-    run = _Run(m, palm, tips, chains, frozen=[j for j in range(m.njnt) if m.jnt_bodyid[j] not in subtree],
-               steps=tuple(max(1, round(t / m.opt.timestep)) for t in (SETTLE_TIME, close_time, hold_time)))
-    lo, hi = m.actuator_ctrlrange[acts, 0], m.actuator_ctrlrange[acts, 1]
-    tips_palm, joint_records, d = run(acts, lo, hi, held, source)
-    if _spread(tips_palm[:, -1]) > _spread(tips_palm[:, 0]):  # the high ends open the hand: close toward the low
-        lo, hi = hi, lo
-        tips_palm, joint_records, d = run(acts, lo, hi, held, source)
+    lo, hi, (tips_palm, joint_records, d) = _closing_ends(run, acts, held, source)
     moved = np.linalg.norm(tips_palm - tips_palm[:, :1], axis=2).max(axis=1)
     if (still := np.flatnonzero(moved < tol.FINGER_MOVED)).size:
         i = int(still[0])
@@ -394,6 +386,116 @@ def close_model(spec: ModelSpec, *, close_time: float = 1.0, hold_time: float = 
                        joints=tuple(np.transpose(j, (1, 0, 2)) @ axes.T - shift for j in joint_records),
                        radius=np.array([_tip_radius(m, t, collides) for t in tips]),
                        palm=None if palm_geoms is None else palm_plate(palm_geoms - shift))
+
+
+def fingertip_forces(model, *, fingertips=None, actuators=None, palm=None, progress=FORCE_PROGRESS,
+                     close_time: float = 3.0) -> dict[float, dict[str, float]]:
+    """How hard each fingertip of a hand model pushes along its closing path, N, at points of the closing.
+
+    The model is closed in free air as :func:`derive_hand` closes it (module docstring: palm fixed,
+    gravity and contacts off, the synergy ramped from open to closed over ``close_time``, held
+    pre-shapes kept). At each fraction ``progress`` of the ramp, every synergy actuator is commanded
+    fully closed for an instant and the joint forces it then applies, ``tau``, are read; a fingertip's
+    force along its direction of motion ``d`` is the virtual-work estimate
+    ``tau . (J^T d) / |J^T d|^2`` (``J`` the fingertip's translational Jacobian): the force an object
+    in the fingertip's way would feel while the finger's joints are still short of their targets. It
+    is what a servo's force limit or a motor's torque gives at the tip, not a contact simulation: a
+    finger whose drive saturates pushes with its limit over its lever.
+
+    Parameters
+    ----------
+    model : str, Path or ModelSpec
+        As :func:`derive_hand`; ``fingertips``, ``actuators`` and ``palm`` override its spec.
+    progress : sequence of float
+        Fractions of the ramp, each in (0, 1].
+    close_time : float
+        The ramp, s.
+
+    Returns
+    -------
+    dict
+        progress -> finger name -> force, N (negative: the drive holds the finger back there; NaN: the
+        fingertip is not moving then, slower than ``tolerances.FINGERTIP_MOVING``).
+
+    Raises
+    ------
+    HandFileError, HandError, SimulationError
+        As :func:`derive_hand`; HandError also for a ``progress`` outside (0, 1] or none.
+
+    Examples
+    --------
+    >>> forces = fingertip_forces("jaco-three-finger", progress=(0.6,))
+    >>> {name: round(force, 1) for name, force in forces[0.6].items()}
+    {'thumb': 3.1, 'index': 3.1, 'pinky': 3.1}
+    """
+    spec = model_spec(model, fingertips=fingertips, actuators=actuators, palm=palm)
+    fractions = [validation.bounded("progress", p, 1.0, strict=True, error=HandError) for p in progress]
+    if not fractions:
+        raise HandError("progress must name at least one fraction of the closing")
+    m = load_model(spec.path)
+    run, acts, held = _free_air(m, spec, close_time, 0.0)
+    lo, hi, _ = _closing_ends(run, acts, held, spec.path)
+    names = spec.names or spec.fingertips
+    settle, ramp, _ = run.steps
+    probes = {settle + round(p * ramp): p for p in fractions}
+    forces = {}
+
+    def probe(k, d):
+        if k in probes:
+            forces[probes[k]] = dict(zip(names, _pushes(m, d, run.tips, acts, hi), strict=True))
+
+    run(acts, lo, hi, held, spec.path, probe=probe)
+    return {p: forces[p] for p in fractions}
+
+
+
+def _pushes(m, d, tips, acts, closed) -> list[float]:
+    """Each fingertip's force along its motion (:func:`fingertip_forces`), every synergy actuator at ``closed``."""
+    commanded = d.ctrl.copy()
+    d.ctrl[acts] = closed
+    mujoco.mj_forward(m, d)
+    tau = d.qfrc_actuator.copy()
+    pushes = []
+    for tip in tips:
+        jac = np.zeros((3, m.nv))
+        kind, index = tip
+        (mujoco.mj_jacSite if kind == "site" else mujoco.mj_jacBody)(m, d, jac, None, index)
+        velocity = jac @ d.qvel  # the way the tip is moving
+        speed = float(np.linalg.norm(velocity))
+        along = jac.T @ (velocity / max(speed, 1e-12))
+        pushes.append(float(tau @ along / (along @ along)) if speed >= tol.FINGERTIP_MOVING else math.nan)
+    d.ctrl[:] = commanded
+    mujoco.mj_forward(m, d)
+    return pushes
+
+
+def _free_air(m, spec: ModelSpec, close_time: float, hold_time: float) -> tuple[_Run, np.ndarray, list]:
+    """Set ``m`` up for a closing in free air (module docstring) and the run that closes it, with the
+    synergy's actuators and the held ones."""
+    source = spec.path
+    m.opt.gravity[:] = 0.0
+    m.opt.timestep, m.opt.integrator = TIMESTEP, mujoco.mjtIntegrator.mjINT_IMPLICITFAST  # the scene's
+    m.geom_contype[:] = m.geom_conaffinity[:] = 0  # free air: nothing to touch, fingers pass each other (as in the scene)
+    palm = _palm_body(m, spec, source)
+    subtree = _subtree(m, palm)
+    tips = [_fingertip(m, name, subtree, source) for name in spec.fingertips]
+    acts = _actuators(m, spec.actuators, subtree, source)
+    held = _held(m, spec, subtree, source)
+    run = _Run(m, palm, tips, [_moving_path(m, tip, palm) for tip in tips],
+               frozen=[j for j in range(m.njnt) if m.jnt_bodyid[j] not in subtree],
+               steps=tuple(max(1, round(t / m.opt.timestep)) for t in (SETTLE_TIME, close_time, hold_time)))
+    return run, acts, held
+
+
+def _closing_ends(run: _Run, acts, held, source: str):
+    """The synergy's open and closed controls, and the run that closes from one to the other: the low
+    ends of the control ranges open the hand unless the fingertips end farther apart than they began."""
+    lo, hi = run.m.actuator_ctrlrange[acts, 0], run.m.actuator_ctrlrange[acts, 1]
+    closing = run(acts, lo, hi, held, source)
+    if _spread(closing[0][:, -1]) > _spread(closing[0][:, 0]):  # the high ends open the hand: close toward the low
+        lo, hi = hi, lo
+        closing = run(acts, lo, hi, held, source)
+    return lo, hi, closing
 
 
 def _finger_bodies(m, palm: int, tips) -> tuple[tuple[str, int], ...]:
@@ -427,8 +529,10 @@ class _Run:
     frozen: list
     steps: tuple[int, int, int]
 
-    def __call__(self, acts, open_ctrl, closed_ctrl, held, source):
-        """Fingertips (n, k, 3) and per finger its hinge anchors (k, j, 3), palm frame, and the final data."""
+    def __call__(self, acts, open_ctrl, closed_ctrl, held, source, probe=None):
+        """Fingertips (n, k, 3) and per finger its hinge anchors (k, j, 3), palm frame, and the final data.
+
+        ``probe(k, data)``, if given, is called after every step k (its state unchanged on return)."""
         m, d = self.m, mujoco.MjData(self.m)
         settle, ramp, hold = self.steps
         for a, value in held:
@@ -440,6 +544,8 @@ class _Run:
                 d.ctrl[acts] = open_ctrl + u * (closed_ctrl - open_ctrl)
                 _freeze(m, d, self.frozen)
                 mujoco.mj_step(m, d) if k else mujoco.mj_forward(m, d)
+                if probe is not None:
+                    probe(k, d)
                 if k >= settle:
                     position, rotation = d.xpos[self.palm].copy(), d.xmat[self.palm].reshape(3, 3).copy()
                     records.append([(_point(d, t) - position) @ rotation for t in self.tips])
