@@ -60,6 +60,9 @@ its chains and palm only when every finger has a chain; otherwise it is a 2-D ha
 :attr:`Derivation.notes` says why. Finger radius: half the smallest extent of the
 fingertip body's collision geoms.
 
+*Forces* (:func:`fingertip_forces`, not part of the hand file): how hard each fingertip pushes along
+its path during the same closing, read from the drives' joint forces.
+
 *Gains.* The model says nothing about the planner's gains: every finger gets ``alpha`` 25 and
 ``beta`` 10000 (the five-finger preset's), none is required, and ``min_touching`` is every finger
 for up to three fingers, all but one beyond.
@@ -437,16 +440,15 @@ def fingertip_forces(model, *, fingertips=None, actuators=None, palm=None, progr
     lo, hi, _ = _closing_ends(run, acts, held, spec.path)
     names = spec.names or spec.fingertips
     settle, ramp, _ = run.steps
-    probes = {settle + round(p * ramp): p for p in fractions}
+    steps = {p: settle + round(p * ramp) for p in fractions}
     forces = {}
 
     def probe(k, d):
-        if k in probes:
-            forces[probes[k]] = dict(zip(names, _pushes(m, d, run.tips, acts, hi), strict=True))
+        if k in steps.values():
+            forces[k] = dict(zip(names, _pushes(m, d, run.tips, acts, hi), strict=True))
 
     run(acts, lo, hi, held, spec.path, probe=probe)
-    return {p: forces[p] for p in fractions}
-
+    return {p: forces[k] for p, k in steps.items()}
 
 
 def _pushes(m, d, tips, acts, closed) -> list[float]:
