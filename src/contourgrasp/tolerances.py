@@ -253,7 +253,7 @@ CLOSED_WITHIN = 5e-4
 #: A simulated fingertip that has travelled this far has started to move, m.
 FINGER_MOVED = 1e-3
 
-#: model_hand.fingertip_forces: a fingertip slower than this has no direction of motion to push along
+#: model_force.fingertip_forces: a fingertip slower than this has no direction of motion to push along
 #: (stopped at a joint limit, say), m/s; a 3 s closing moves the bundled models' tips at 20-40 mm/s.
 FINGERTIP_MOVING = 1e-3
 

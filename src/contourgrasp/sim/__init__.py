@@ -12,6 +12,7 @@
 * :mod:`~contourgrasp.sim.bench` -- Table 4.4 as a benchmark (``contourgrasp bench``), with its figures
 * :mod:`~contourgrasp.sim.calibrate` -- virtual starts from the simulated hand's closing
 * :mod:`~contourgrasp.sim.model_hand` -- a hand file from a MuJoCo hand model (``hand-from-model``)
+* :mod:`~contourgrasp.sim.model_force` -- how hard that model's fingertips push along their closing
 * :mod:`~contourgrasp.sim.model_mount` -- that model as the simulated hand (``bench --hand-model``)
 
 Needs ``mujoco`` (4.x: ``mj_multiRay`` takes a ``normal`` argument), ``trimesh``
@@ -27,7 +28,8 @@ Example::
 from .hand_model import TIMINGS, ChainRule, FingerTiming, HandDesign, HandModel, build_hand, derive_body
 from .measure import fingertip_path_error, fingertip_paths
 from .model_fit import FingerFit, fit_finger
-from .model_hand import MODELS, Derivation, ModelSpec, derive_hand, fingertip_forces
+from .model_force import fingertip_forces
+from .model_hand import MODELS, Derivation, ModelSpec, derive_hand
 from .model_mount import MountedHand, mount_model
 from .objects import THESIS_OBJECTS, ObjectSpec, Part, mesh_object, object_spec
 from .render import BIN_LABEL, DepthNoise, object_truth, render, render_view, tilted_view, truth_labels

@@ -60,8 +60,8 @@ its chains and palm only when every finger has a chain; otherwise it is a 2-D ha
 :attr:`Derivation.notes` says why. Finger radius: half the smallest extent of the
 fingertip body's collision geoms.
 
-*Forces* (:func:`fingertip_forces`, not part of the hand file): how hard each fingertip pushes along
-its path during the same closing, read from the drives' joint forces.
+*Forces* (:func:`contourgrasp.sim.model_force.fingertip_forces`, not part of the hand file): how hard
+each fingertip pushes along its path during the same closing, read from the drives' joint forces.
 
 *Gains.* The model says nothing about the planner's gains: every finger gets ``alpha`` 25 and
 ``beta`` 10000 (the five-finger preset's), none is required, and ``min_touching`` is every finger
@@ -70,7 +70,6 @@ for up to three fingers, all but one beyond.
 
 from __future__ import annotations
 
-import math
 import os
 from dataclasses import dataclass, replace
 from importlib import resources
@@ -82,7 +81,6 @@ os.environ.setdefault("MUJOCO_GL", "disable")
 import mujoco  # noqa: E402
 
 from .. import tolerances as tol  # noqa: E402
-from .. import validation  # noqa: E402
 from ..errors import HandError, HandFileError, SimulationError  # noqa: E402
 from ..hand import Hand, Palm, SampledChain  # noqa: E402
 from .calibrate import Closing, derive_virtual_starts  # noqa: E402
@@ -98,8 +96,6 @@ MISS_PENALTY = 250.0
 LEVEL = "level"
 #: The approach reading along the fingers (a ModelSpec's None), to override a bundled model's.
 ALONG_FINGERS = "fingers"
-#: Where along the synergy's ramp :func:`fingertip_forces` reads the forces by default.
-FORCE_PROGRESS = (0.4, 0.6, 0.8)
 
 
 @dataclass(frozen=True)
@@ -389,86 +385,6 @@ def close_model(spec: ModelSpec, *, close_time: float = 1.0, hold_time: float = 
                        joints=tuple(np.transpose(j, (1, 0, 2)) @ axes.T - shift for j in joint_records),
                        radius=np.array([_tip_radius(m, t, collides) for t in tips]),
                        palm=None if palm_geoms is None else palm_plate(palm_geoms - shift))
-
-
-def fingertip_forces(model, *, fingertips=None, actuators=None, palm=None, progress=FORCE_PROGRESS,
-                     close_time: float = 3.0) -> dict[float, dict[str, float]]:
-    """How hard each fingertip of a hand model pushes along its closing path, N, at points of the closing.
-
-    The model is closed in free air as :func:`derive_hand` closes it (module docstring: palm fixed,
-    gravity and contacts off, the synergy ramped from open to closed over ``close_time``, held
-    pre-shapes kept). At each fraction ``progress`` of the ramp, every synergy actuator is commanded
-    fully closed for an instant and the joint forces it then applies, ``tau``, are read; a fingertip's
-    force along its direction of motion ``d`` is the virtual-work estimate
-    ``tau . (J^T d) / |J^T d|^2`` (``J`` the fingertip's translational Jacobian): the force an object
-    in the fingertip's way would feel while the finger's joints are still short of their targets. It
-    is what a servo's force limit or a motor's torque gives at the tip, not a contact simulation: a
-    finger whose drive saturates pushes with its limit over its lever.
-
-    Parameters
-    ----------
-    model : str, Path or ModelSpec
-        As :func:`derive_hand`; ``fingertips``, ``actuators`` and ``palm`` override its spec.
-    progress : sequence of float
-        Fractions of the ramp, each in (0, 1].
-    close_time : float
-        The ramp, s.
-
-    Returns
-    -------
-    dict
-        progress -> finger name -> force, N (negative: the drive holds the finger back there; NaN: the
-        fingertip is not moving then, slower than ``tolerances.FINGERTIP_MOVING``).
-
-    Raises
-    ------
-    HandFileError, HandError, SimulationError
-        As :func:`derive_hand`; HandError also for a ``progress`` outside (0, 1] or none.
-
-    Examples
-    --------
-    >>> forces = fingertip_forces("jaco-three-finger", progress=(0.6,))
-    >>> {name: round(force, 1) for name, force in forces[0.6].items()}
-    {'thumb': 3.1, 'index': 3.1, 'pinky': 3.1}
-    """
-    spec = model_spec(model, fingertips=fingertips, actuators=actuators, palm=palm)
-    fractions = [validation.bounded("progress", p, 1.0, strict=True, error=HandError) for p in progress]
-    if not fractions:
-        raise HandError("progress must name at least one fraction of the closing")
-    m = load_model(spec.path)
-    run, acts, held = _free_air(m, spec, close_time, 0.0)
-    lo, hi, _ = _closing_ends(run, acts, held, spec.path)
-    names = spec.names or spec.fingertips
-    settle, ramp, _ = run.steps
-    steps = {p: settle + round(p * ramp) for p in fractions}
-    forces = {}
-
-    def probe(k, d):
-        if k in steps.values():
-            forces[k] = dict(zip(names, _pushes(m, d, run.tips, acts, hi), strict=True))
-
-    run(acts, lo, hi, held, spec.path, probe=probe)
-    return {p: forces[k] for p, k in steps.items()}
-
-
-def _pushes(m, d, tips, acts, closed) -> list[float]:
-    """Each fingertip's force along its motion (:func:`fingertip_forces`), every synergy actuator at ``closed``."""
-    commanded = d.ctrl.copy()
-    d.ctrl[acts] = closed
-    mujoco.mj_forward(m, d)
-    tau = d.qfrc_actuator.copy()
-    pushes = []
-    for tip in tips:
-        jac = np.zeros((3, m.nv))
-        kind, index = tip
-        (mujoco.mj_jacSite if kind == "site" else mujoco.mj_jacBody)(m, d, jac, None, index)
-        velocity = jac @ d.qvel  # the way the tip is moving
-        speed = float(np.linalg.norm(velocity))
-        along = jac.T @ (velocity / max(speed, 1e-12))
-        pushes.append(float(tau @ along / (along @ along)) if speed >= tol.FINGERTIP_MOVING else math.nan)
-    d.ctrl[:] = commanded
-    mujoco.mj_forward(m, d)
-    return pushes
 
 
 def _free_air(m, spec: ModelSpec, close_time: float, hold_time: float) -> tuple[_Run, np.ndarray, list]:
