@@ -253,6 +253,10 @@ CLOSED_WITHIN = 5e-4
 #: A simulated fingertip that has travelled this far has started to move, m.
 FINGER_MOVED = 1e-3
 
+#: Longest closing or hold of a hand model in free air (model_hand.derive_hand, model_force.fingertip_forces), s:
+#: a bound on the simulation an argument can ask for (the defaults are 1-3 s).
+MAX_MODEL_CLOSING_TIME = 60.0
+
 #: model_force.fingertip_forces: a fingertip slower than this has no direction of motion to push along
 #: (stopped at a joint limit, say), m/s; a 3 s closing moves the bundled models' tips at 20-40 mm/s.
 FINGERTIP_MOVING = 1e-3

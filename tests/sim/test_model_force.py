@@ -36,3 +36,9 @@ def test_the_jaco_models_three_identical_fingers_push_alike():
 def test_fingertip_forces_refuse_a_progress_outside_the_closing(progress):
     with pytest.raises(HandError, match="progress"):
         fingertip_forces(LEVER_AND_SLIDER, fingertips=["lever_tip", "slider_tip"], progress=progress)
+
+
+@pytest.mark.parametrize("close_time", [0.0, -1.0, float("inf"), 1e6])
+def test_fingertip_forces_refuse_a_closing_time_out_of_range(close_time):
+    with pytest.raises(HandError, match="close_time"):
+        fingertip_forces(LEVER_AND_SLIDER, fingertips=["lever_tip", "slider_tip"], close_time=close_time)

@@ -168,6 +168,8 @@ def test_bad_models_are_refused_naming_what(sliders, tmp_path):
         derive_hand(broken, fingertips=["tip"])
     with pytest.raises(HandFileError, match="name the fingertips"):
         derive_hand(sliders)
+    with pytest.raises(HandError, match="hold_time"):
+        derive_hand(sliders, fingertips=["left_tip", "right_tip"], hold_time=1e6)  # a bound on the simulation asked for
     assert set(MODELS) == {"inspire", "jaco-three-finger"}
 
 

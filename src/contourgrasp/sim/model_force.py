@@ -48,7 +48,7 @@ def fingertip_forces(model, *, fingertips=None, actuators=None, palm=None, progr
     progress : sequence of float
         Fractions of the ramp, each in (0, 1].
     close_time : float
-        The ramp, s.
+        The ramp, s, in (0, ``tolerances.MAX_MODEL_CLOSING_TIME``].
 
     Returns
     -------
@@ -60,7 +60,7 @@ def fingertip_forces(model, *, fingertips=None, actuators=None, palm=None, progr
     ------
     HandFileError, HandError, SimulationError
         As :func:`~contourgrasp.sim.model_hand.derive_hand`; HandError also for a ``progress`` outside (0, 1]
-        or none.
+        or none, or a ``close_time`` out of range.
 
     Examples
     --------

@@ -81,6 +81,7 @@ os.environ.setdefault("MUJOCO_GL", "disable")
 import mujoco  # noqa: E402
 
 from .. import tolerances as tol  # noqa: E402
+from .. import validation  # noqa: E402
 from ..errors import HandError, HandFileError, SimulationError  # noqa: E402
 from ..hand import Hand, Palm, SampledChain  # noqa: E402
 from .calibrate import Closing, derive_virtual_starts  # noqa: E402
@@ -310,7 +311,7 @@ def derive_hand(model, *, fingertips=None, actuators=None, palm=None, approach=N
     name : str, optional
         The hand's name; default the model file's stem.
     close_time, hold_time : float
-        Synergy ramp and hold, s.
+        Synergy ramp (> 0) and hold (>= 0), s, each at most ``tolerances.MAX_MODEL_CLOSING_TIME``.
 
     Returns
     -------
@@ -322,7 +323,8 @@ def derive_hand(model, *, fingertips=None, actuators=None, palm=None, approach=N
         The model cannot be loaded, a fingertip, actuator or palm it does not have, or an actuator
         without a control range.
     HandError
-        A fingertip the actuators do not move, or a path no ray or arc fits (naming the finger).
+        A fingertip the actuators do not move, or a path no ray or arc fits (naming the finger); a
+        ``close_time`` or ``hold_time`` out of range.
     SimulationError
         The model is unstable while closing.
     """
@@ -391,6 +393,9 @@ def _free_air(m, spec: ModelSpec, close_time: float, hold_time: float) -> tuple[
     """Set ``m`` up for a closing in free air (module docstring) and the run that closes it, with the
     synergy's actuators and the held ones."""
     source = spec.path
+    close_time = validation.bounded("close_time", close_time, tol.MAX_MODEL_CLOSING_TIME, " s", strict=True,
+                                    error=HandError)
+    hold_time = validation.bounded("hold_time", hold_time, tol.MAX_MODEL_CLOSING_TIME, " s", error=HandError)
     m.opt.gravity[:] = 0.0
     m.opt.timestep, m.opt.integrator = TIMESTEP, mujoco.mjtIntegrator.mjINT_IMPLICITFAST  # the scene's
     m.geom_contype[:] = m.geom_conaffinity[:] = 0  # free air: nothing to touch, fingers pass each other (as in the scene)
