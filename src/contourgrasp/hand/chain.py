@@ -190,8 +190,8 @@ class Palm:
 
     Examples
     --------
-    >>> Palm(outline=((0, 0, 0.01), (0.1, 0, 0.03), (0.1, 0.1, 0.03), (0, 0.1, 0.01)), thickness=0.02).plane.round(3)
-    array([0.01, 0.2 , 0.  ])
+    >>> Palm(outline=((0, 0, 0.01), (0.1, 0, 0.03), (0.1, 0.1, 0.04), (0, 0.1, 0.02)), thickness=0.02).plane.round(3)
+    array([0.01, 0.2 , 0.1 ])
     """
 
     outline: tuple[tuple[float, float], ...]
