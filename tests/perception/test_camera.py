@@ -32,14 +32,18 @@ def test_depth_holes_are_filled_when_small():
     assert iou(segment_depth(holed, CAMERA).mask, truth) > 0.95
 
 
+@pytest.mark.parametrize("call_px", [-10**9, 10**9], ids=["hole-by-hole", "one-box"])
 @settings(max_examples=100, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), missing=st.floats(0.05, 0.9), max_hole_px=st.sampled_from([1, 6, 40, 10**6]))
-def test_hole_takes_the_nearest_reading_of_the_whole_image(seed, missing, max_hole_px):
-    # The fill looks for readings near the holes only; it must find those of a search over the whole image.
+def test_hole_takes_the_nearest_reading_of_the_whole_image(call_px, seed, missing, max_hole_px):
+    # The fill looks for readings near the holes only, in one box or hole by hole (forced here by the
+    # cost of a call); either must find those of a search over the whole image.
     rng = np.random.default_rng(seed)
     depth = rng.uniform(0.5, 1.0, tuple(rng.integers(2, 40, 2)))
     depth[rng.random(depth.shape) < missing] = 0.0
-    filled, count = fill_depth_holes(depth, max_hole_px=max_hole_px)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(camera_module, "HOLE_CALL_PX", call_px)
+        filled, count = fill_depth_holes(depth, max_hole_px=max_hole_px)
     labels, _ = ndimage.label(depth == 0, structure=np.ones((3, 3)))
     small = (np.bincount(labels.ravel()) <= max_hole_px)[labels] & (labels > 0)
     _, (rows, cols) = ndimage.distance_transform_edt(depth == 0, return_indices=True)

@@ -165,30 +165,63 @@ def fill_depth_holes(depth, *, max_hole_px: int = MAX_HOLE_PX) -> tuple[np.ndarr
     small[0] = False
     if not small.any():
         return d.copy(), 0
-    box = _hole_box(stats[small], d.shape)
-    fill = small[labels[box]]
-    _, (rows, cols) = ndimage.distance_transform_edt(missing[box], return_indices=True)
     out = d.copy()
-    out[box][fill] = d[box][rows[fill], cols[fill]]
+    for box, fill in _fill_boxes(labels, stats, small, d.shape):
+        _, (rows, cols) = ndimage.distance_transform_edt(missing[box], return_indices=True)
+        out[box][fill] = d[box][rows[fill], cols[fill]]
     return out, int(stats[small, cv2.CC_STAT_AREA].sum())
 
 
-def _hole_box(stats, shape):
-    """Slices of the image holding the nearest readings of the holes in ``stats`` (OpenCV's rows).
+#: What one more distance transform costs beyond its pixels, in pixels (about 30 us against 60 ns a
+#: pixel, measured with scipy's): :func:`_fill_boxes` searches hole by hole only where that is cheaper.
+HOLE_CALL_PX = 512
+
+
+def _fill_boxes(labels, stats, small, shape):
+    """(box, fill) pairs: image slices to search and the pixels of ``small`` holes each fills.
+
+    Either one box around all the small holes or one box per hole, whichever has fewer pixels to
+    transform, counting :data:`HOLE_CALL_PX` per box: a few holes scattered over a real frame
+    would otherwise span most of it (the bar clamp's 21: 340 x 535 pixels). Both hold every hole
+    pixel's nearest reading (:func:`_hole_boxes`).
+    """
+    holes = np.flatnonzero(small)
+    own = _hole_boxes(stats[holes], shape)
+    whole = _hole_boxes(stats[holes], shape, together=True)[0]
+    if ((own[:, 1] - own[:, 0]) * (own[:, 3] - own[:, 2]) + HOLE_CALL_PX).sum() < _pixels(whole):
+        return [(_slices(box), labels[_slices(box)] == hole) for box, hole in zip(own, holes)]
+    return [(_slices(whole), small[labels[_slices(whole)]])]
+
+
+def _hole_boxes(stats, shape, *, together: bool = False) -> np.ndarray:
+    """(n, 4) int: (top, bottom, left, right) of a box holding the nearest readings of each hole in
+    ``stats`` (OpenCV's rows), or (1, 4) of one box for all of them ``together``.
 
     A pixel of a hole at most ``e`` pixels wide and high has a reading within
     ``e`` pixels along its row or its column: the first pixel past the hole
     there is not missing (it would belong to the hole), unless the hole runs
     from edge to edge both ways, and then ``e`` spans the image. So every
-    nearest reading lies within the holes' bounding box grown by the largest
-    ``e``, and the distance transform need not look farther.
+    nearest reading lies within the hole's bounding box grown by its ``e`` (all
+    the holes' grown by the largest ``e``), and the distance transform need not
+    look farther.
     """
-    reach = int(stats[:, [cv2.CC_STAT_WIDTH, cv2.CC_STAT_HEIGHT]].max())
-    top = stats[:, cv2.CC_STAT_TOP].min() - reach
-    left = stats[:, cv2.CC_STAT_LEFT].min() - reach
-    bottom = (stats[:, cv2.CC_STAT_TOP] + stats[:, cv2.CC_STAT_HEIGHT]).max() + reach
-    right = (stats[:, cv2.CC_STAT_LEFT] + stats[:, cv2.CC_STAT_WIDTH]).max() + reach
-    return np.s_[max(top, 0): min(bottom, shape[0]), max(left, 0): min(right, shape[1])]
+    top, left = stats[:, cv2.CC_STAT_TOP], stats[:, cv2.CC_STAT_LEFT]
+    height, width = stats[:, cv2.CC_STAT_HEIGHT], stats[:, cv2.CC_STAT_WIDTH]
+    reach = np.maximum(width, height)
+    if together:
+        reach = reach.max()
+    boxes = np.c_[top - reach, top + height + reach, left - reach, left + width + reach]
+    if together:
+        boxes = np.array([[boxes[:, 0].min(), boxes[:, 1].max(), boxes[:, 2].min(), boxes[:, 3].max()]])
+    return np.clip(boxes, 0, [shape[0], shape[0], shape[1], shape[1]])
+
+
+def _slices(box):
+    return np.s_[box[0]:box[1], box[2]:box[3]]
+
+
+def _pixels(box) -> int:
+    return int((box[1] - box[0]) * (box[3] - box[2]))
 
 
 def pixel_points(depth, intrinsics, rows, cols) -> np.ndarray:
