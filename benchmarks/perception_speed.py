@@ -4,8 +4,9 @@ Frames:
 
 (a) simulated: ``contourgrasp.sim.build_scene(name, seed=s)`` rendered with noise for the objects
     can, case, bottle, stone1, stone2 and seeds 0 .. ``--seeds`` - 1;
-(b) real: the PrimeSense frames of ``<data>/rgbd/*/`` loaded as in ``benchmarks/segmentation.py``
-    (skipped when the folder is absent).
+(b) real: the bundled bar-clamp frame (``examples/bar_clamp``, the ROS latency benchmark's) and the
+    PrimeSense frames of ``<data>/rgbd/*/`` loaded as in ``benchmarks/segmentation.py`` (skipped when
+    the folder is absent).
 
 Each frame is run once untimed (warm-up), then ``--runs`` times; the median is reported. The stages
 are timed separately, in the order :func:`contourgrasp.pipeline.perceive` runs them: ``fill``
@@ -50,6 +51,7 @@ import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
 from contourgrasp import perception, pipeline  # noqa: E402
+from contourgrasp.io.camera_file import read_depth, read_intrinsics, read_rgb  # noqa: E402
 from contourgrasp.sim import build_scene, render  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -58,6 +60,7 @@ from segmentation import frames as real_frames  # noqa: E402
 from segmentation import grey  # noqa: E402
 
 SIM_OBJECTS = ("can", "case", "bottle", "stone1", "stone2")
+BAR_CLAMP = Path(__file__).resolve().parents[1] / "examples" / "bar_clamp"
 STAGES = ("fill", "segment", "metric", "perceive")
 CLOCKS = {"cpu": time.process_time, "wall": time.perf_counter}
 #: Perception's share of the planner's 100 ms budget per frame.
@@ -71,6 +74,12 @@ def sim_frames(seeds: int):
             scene = build_scene(name, seed=seed)
             rgb, depth = render(scene, noise=True, seed=seed)
             yield f"sim {name} s{seed}", rgb, depth, scene.camera.intrinsics
+
+
+def bundled_frame():
+    """(name, rgb, depth, intrinsics) of the bundled bar-clamp frame."""
+    return ("examples/bar_clamp", read_rgb(BAR_CLAMP / "color_0.png"), read_depth(BAR_CLAMP / "depth_0.npy"),
+            read_intrinsics(BAR_CLAMP / "primesense_overhead_color.intr"))
 
 
 def stage_times(rgb, depth, intrinsics, clock) -> dict[str, float]:
@@ -137,7 +146,8 @@ def main(argv=None) -> int:
     frames = list(sim_frames(args.seeds))
     real = [(name, rgb, depth, intrinsics) for name, rgb, depth, intrinsics, _ in real_frames(args.data)]
     if not real:
-        print(f"no real frames under {args.data}/rgbd: simulated frames only", file=sys.stderr)
+        print(f"no real frames under {args.data}/rgbd: simulated frames and the bar clamp only", file=sys.stderr)
+    real.insert(0, bundled_frame())
     results = {}
     for name, rgb, depth, intrinsics in frames + real:
         results[name] = median_ms(grey(rgb) if args.grey else rgb, depth, intrinsics, args.runs, CLOCKS[args.clock])
