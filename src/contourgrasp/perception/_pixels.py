@@ -17,6 +17,25 @@ def connected_to(region, mask):
     return keep[labels]
 
 
+def components(mask):
+    """(count, labels, areas): the 8-connected regions of ``mask``, labelled as
+    :func:`cv2.connectedComponentsWithStats` labels them (0 the background, counted in ``count``),
+    and each label's pixels.
+
+    OpenCV's statistics (every label's box and centroid, the background's too) cost several
+    times the labelling; where only areas are needed they are one bincount.
+
+    Examples
+    --------
+    >>> mask = np.zeros((4, 6), bool); mask[1, 1] = True; mask[1:3, 3:5] = True
+    >>> count, labels, areas = components(mask)
+    >>> int(count), areas.tolist()
+    (3, [19, 1, 4])
+    """
+    count, labels = cv2.connectedComponents(mask.astype(np.uint8), connectivity=8)
+    return count, labels, np.bincount(labels.ravel(), minlength=count)
+
+
 def disc(radius):
     """OpenCV's elliptic structuring element of ``radius`` px."""
     return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 1, 2 * radius + 1))

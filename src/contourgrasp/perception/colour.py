@@ -35,7 +35,7 @@ from ..errors import PerceptionError
 from ..tolerances import (COLOUR_DISTANCE, EVIDENCE_OPEN_PX, FLAT_GAP_PX, FLAT_HEIGHT_SIGMAS, FLAT_WINDOW_PX, HALO_PX,
                           LIGHTNESS_WEIGHT, MAX_COLOUR_OFFSET_PX, MIN_AREA_PX, MIN_FLAT_HEIGHT, MIN_HEIGHT, REGISTRATION_MARGIN_PX,
                           SHADOW_LIGHTNESS)
-from ._pixels import connected_to, dilate, grown_box, opening, pixel_box
+from ._pixels import components, connected_to, dilate, grown_box, opening, pixel_box
 from .camera import as_depth, as_rgb, check_intrinsics, valid_depth
 from .region import Segmentation, make_segmentation, pick_object
 from .table import heights
@@ -166,8 +166,8 @@ def add_flat_parts(
     unlike = _unlike_table(image, seg.mask, halo, seg.plane.inliers, height, _Evidence(
         colour_distance, lightness_weight, shadow_lightness, halo_px, gap_px if grey else 0, height_sigmas, min_height,
         min_area_px))
-    _, labels, stats, _ = cv2.connectedComponentsWithStats((unlike & ~halo).astype(np.uint8), connectivity=8)
-    large = stats[:, cv2.CC_STAT_AREA] >= min_area_px
+    _, labels, areas = components(unlike & ~halo)
+    large = areas >= min_area_px
     large[0] = False
     flat = large[labels]
     if not flat.any():
@@ -265,8 +265,8 @@ def _other_objects(standing, mask, min_area_px) -> np.ndarray:
     Outside the mask, not merely not touching it: a candidate split from a bin's wall
     (:func:`~contourgrasp.perception.candidates.split_at_depth_steps`) touches the wall.
     """
-    count, labels, stats, _ = cv2.connectedComponentsWithStats((standing & ~mask).astype(np.uint8), connectivity=8)
-    other = stats[:, cv2.CC_STAT_AREA] >= min_area_px
+    _, labels, areas = components(standing & ~mask)
+    other = areas >= min_area_px
     other[0] = False
     return other[labels]
 
@@ -287,8 +287,8 @@ def _joined(evidence, mask, gap_px, min_area_px) -> np.ndarray:
     joined = connected_to(evidence | mask, mask)
     if gap_px == 0:
         return joined
-    count, labels, stats, _ = cv2.connectedComponentsWithStats((evidence & ~joined).astype(np.uint8), connectivity=8)
-    pending = [i for i in range(1, count) if stats[i, cv2.CC_STAT_AREA] >= min_area_px]
+    count, labels, areas = components(evidence & ~joined)
+    pending = [i for i in range(1, count) if areas[i] >= min_area_px]
     while pending:
         rows, cols = np.nonzero(np.isin(labels, pending))
         box = pixel_box(rows, cols, gap_px, mask.shape)

@@ -23,6 +23,7 @@ from scipy import ndimage
 from ..contour.polygon import repair_self_intersections
 from ..errors import PerceptionWarning, SegmentationError
 from ..tolerances import CONTOUR_EPSILON_PX, MAX_OUTLINE_POINTS, SIMILAR_SIZE
+from ._pixels import components
 from .table import Plane
 
 
@@ -93,11 +94,10 @@ def pick_object(candidates, outside, min_area_px, where, target=None):
     overlaps it most is taken instead, and no "similar size" warning is given;
     it must not touch the border or ``outside``.
     """
-    count, labels, stats, _ = cv2.connectedComponentsWithStats(candidates.astype(np.uint8), connectivity=8)
+    count, labels, areas = components(candidates)
     count -= 1
     if count == 0:
         raise SegmentationError("no-object", f"no object found: no region {where}")
-    areas = stats[:, cv2.CC_STAT_AREA]
     touching = touching_regions(labels, count, outside)
     if target is not None:
         return _pick_target(labels, count, touching, np.asarray(target, dtype=bool), where)
