@@ -223,12 +223,12 @@ def plan_frame(
         T_base_camera = validation.rigid_transform("T_base_camera", T_base_camera, error=PerceptionError,
                                                    rotation_tolerance=ROTATION_TOLERANCE,
                                                    row_tolerance=HOMOGENEOUS_ROW)
-    seg, metric, filled, d, table, scene = _perceive(rgb, depth, intrinsics, segment=segment, mask=mask, depth_mode=depth_mode,
-                                              footprint=footprint, fill_holes=fill_holes,
-                                              colour_offset_px=colour_offset_px, approach_offset=approach_offset,
-                                              target_px=target_px, roi=roi,
-                                              max_width=perception.hand_opening(hand))
-    heights = scene_heights(d, intrinsics, seg, metric, plane=table)
+    with perception.one_frame():
+        seg, metric, filled, d, table, scene = _perceive(
+            rgb, depth, intrinsics, segment=segment, mask=mask, depth_mode=depth_mode, footprint=footprint,
+            fill_holes=fill_holes, colour_offset_px=colour_offset_px, approach_offset=approach_offset,
+            target_px=target_px, roi=roi, max_width=perception.hand_opening(hand))
+        heights = scene_heights(d, intrinsics, seg, metric, plane=table)
     asked = _grasp_height(hand, heights, descent, grasp_height)
     sweep = validation.flag("closing_sweep", closing_sweep, error=PlannerError)
     closing = validation.flag("closing_obstacles", closing_obstacles, error=PlannerError)
@@ -330,9 +330,10 @@ def perceive(
     Checks the depth, fills small holes, segments (or takes ``mask``) and puts
     the contour in meters; the options are :func:`plan_frame`'s.
     """
-    return _perceive(rgb, depth, intrinsics, segment=segment, mask=mask, depth_mode=depth_mode, footprint=footprint,
-                     fill_holes=fill_holes, colour_offset_px=colour_offset_px, approach_offset=approach_offset,
-                     target_px=target_px)[:3]
+    with perception.one_frame():
+        return _perceive(rgb, depth, intrinsics, segment=segment, mask=mask, depth_mode=depth_mode,
+                         footprint=footprint, fill_holes=fill_holes, colour_offset_px=colour_offset_px,
+                         approach_offset=approach_offset, target_px=target_px)[:3]
 
 
 def _perceive(rgb, depth, intrinsics, *, segment, mask, depth_mode, footprint, fill_holes, colour_offset_px,

@@ -3,6 +3,8 @@
 Every function here works on arrays; reading files is :mod:`contourgrasp.io.camera_file`'s job.
 One module per stage, in the order the pipeline runs them:
 
+* :func:`one_frame` -- the derived images of the frame being perceived (valid readings, heights)
+  computed once for all the stages below
 * :mod:`~contourgrasp.perception.camera` -- intrinsics, depth images (validity, hole filling,
   denoising for nearest points), points of pixels, colour images
 * :mod:`~contourgrasp.perception.table` -- the table plane (RANSAC), heights above it
@@ -32,6 +34,7 @@ masks, timings) in the README's "Perception" section and ``benchmarks/``.
 from __future__ import annotations
 
 from ..errors import PerceptionError, PerceptionWarning, SegmentationError
+from ._frame import one_frame
 from .camera import Intrinsics, as_depth, backproject, denoised_depth, fill_depth_holes, valid_depth
 from .candidates import TARGET_RULES, Candidate, choose_target, find_candidates, hand_opening
 from .colour import add_flat_parts, colour_offset, register_colour
@@ -49,6 +52,6 @@ __all__ = [
     "Candidate", "DEPTH_MODES", "DepthMode", "HeightMap", "Intrinsics", "MetricContour", "PerceptionError", "PerceptionWarning", "Plane",
     "SEGMENT_METHODS", "SegmentMethod", "Segmentation", "SegmentationError", "Support", "TARGET_RULES", "add_flat_parts", "approach_depth",
     "as_depth", "backproject", "choose_target", "colour_offset", "contour_to_metric", "denoised_depth", "fill_depth_holes",
-    "cross_section", "find_candidates", "find_support", "fit_plane", "fit_table_plane", "hand_opening", "height_map", "mask_contour", "object_footprint", "open_table_holes", "register_colour", "segment",
+    "cross_section", "find_candidates", "find_support", "fit_plane", "fit_table_plane", "hand_opening", "height_map", "mask_contour", "object_footprint", "one_frame", "open_table_holes", "register_colour", "segment",
     "segment_depth", "segment_from_mask", "segment_rgb", "valid_depth",
 ]

@@ -21,6 +21,7 @@ from scipy import ndimage
 from .. import validation
 from ..errors import PerceptionError
 from ..tolerances import APPROACH_MEDIAN_PX, MAX_HOLE_PX, SENSOR_RANGE
+from ._frame import memoised
 from ._pixels import pixel_box
 
 
@@ -116,8 +117,12 @@ def valid_depth(depth, depth_range=SENSOR_RANGE) -> np.ndarray:
     """(H, W) bool: finite readings inside ``depth_range`` (m)."""
     d = as_depth(depth)
     lo, hi = validation.depth_range("depth_range", depth_range, error=PerceptionError)
-    with np.errstate(invalid="ignore"):
-        return np.isfinite(d) & (d >= lo) & (d <= hi)
+
+    def valid():
+        with np.errstate(invalid="ignore"):
+            return np.isfinite(d) & (d >= lo) & (d <= hi)
+
+    return memoised(d, ("valid", lo, hi), valid)
 
 
 def backproject(depth, intrinsics: Intrinsics) -> np.ndarray:

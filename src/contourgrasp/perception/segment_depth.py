@@ -18,6 +18,7 @@ from ..errors import PerceptionError
 from ..tolerances import (MAX_HOLE_PX, MIN_AREA_PX, MIN_HEIGHT, MIN_TABLE_HOLE_PX, PLANE_THRESHOLD, SENSOR_RANGE,
                           TILT_PLANE_THRESHOLD)
 from ._pixels import check_pixel, disc, grown_box, in_image
+from ._frame import memoised
 from .camera import Intrinsics, as_depth, check_intrinsics, fill_depth_holes, valid_depth
 from .region import Segmentation, make_segmentation, pick_object
 from .table import Plane, fit_table_plane, footprint_pixels, heights
@@ -125,7 +126,7 @@ def seen_above_table(depth, intrinsics, *, min_height, plane, fill_holes, max_ho
         plane = fit_table_plane(d, intrinsics, depth_range=depth_range, seed=seed)
     above, dead_band = raised_pixels(d, intrinsics, plane, min_height=min_height, depth_range=depth_range)
     if target is not None and np.shape(target) == above.shape:  # (a wrong shape: pick_object's error)
-        above &= np.asarray(target, dtype=bool)  # a candidate is split from what it touches (find_candidates)
+        above = above & np.asarray(target, dtype=bool)  # a candidate is split from what it touches (find_candidates)
     mask, notes = pick_object(above, dead_band, min_area_px,
                                f"more than {min_height * 1000:.0f} mm above the table", target=target)
     return make_segmentation("depth", mask, notes, plane=plane, filled_px=filled), d
@@ -159,10 +160,15 @@ def raised_pixels(depth, intrinsics: Intrinsics, plane: Plane, *, min_height: fl
         Missing readings connected (8-neighbour) to the image border.
     """
     valid = valid_depth(depth, depth_range)
-    with np.errstate(invalid="ignore"):
-        above = valid & (heights(depth, intrinsics, plane) > min_height)
-    above = cv2.morphologyEx(above.astype(np.uint8), cv2.MORPH_OPEN, np.ones((3, 3), np.uint8)) > 0
-    return above, _border_connected(~valid)
+
+    def raised():
+        with np.errstate(invalid="ignore"):
+            above = valid & (heights(depth, intrinsics, plane) > min_height)
+        return cv2.morphologyEx(above.astype(np.uint8), cv2.MORPH_OPEN, np.ones((3, 3), np.uint8)) > 0
+
+    lo_hi = tuple(map(float, depth_range))
+    return (memoised(depth, ("raised", intrinsics, plane.key, float(min_height), lo_hi), raised),
+            memoised(depth, ("dead band", lo_hi), lambda: _border_connected(~valid)))
 
 
 def with_footprint(seg, depth, intrinsics, footprint, min_area_px, *, target_px=None) -> Segmentation:

@@ -16,6 +16,7 @@ from .. import validation
 from ..errors import PerceptionError, SegmentationError
 from ..tolerances import (MAX_TABLE_TILT, MIN_PLANE_FRACTION, PLANE_ITERATIONS, PLANE_SAMPLE, PLANE_STRIDE,
                           PLANE_THRESHOLD, SENSOR_RANGE)
+from ._frame import memoised
 from .camera import Intrinsics, as_depth, check_intrinsics, pixel_points, valid_depth
 
 
@@ -46,6 +47,12 @@ class Plane:
     def height(self, points) -> np.ndarray:
         """(...) float: signed height (m) of (..., 3) camera-frame points above the plane."""
         return np.asarray(points, dtype=float) @ self.normal + self.offset
+
+    @property
+    def key(self) -> tuple:
+        """The plane's normal and offset as a hashable tuple: one frame's images above it are kept by it
+        (:func:`~contourgrasp.perception.one_frame`)."""
+        return (*map(float, self.normal), float(self.offset))
 
 
 #: The thesis's plane: parallel to the image plane; height = -z.
@@ -243,10 +250,14 @@ def heights(depth, intrinsics, plane) -> np.ndarray:
     plus a row term. Non-finite depths give non-finite or NaN heights.
     """
     normal = plane.normal
-    cols = normal[0] * (np.arange(intrinsics.width) - intrinsics.cx) / intrinsics.fx + normal[2]
-    rows = normal[1] * (np.arange(intrinsics.height) - intrinsics.cy) / intrinsics.fy
-    with np.errstate(invalid="ignore"):
-        return depth * (rows[:, None] + cols) + plane.offset
+
+    def compute():
+        cols = normal[0] * (np.arange(intrinsics.width) - intrinsics.cx) / intrinsics.fx + normal[2]
+        rows = normal[1] * (np.arange(intrinsics.height) - intrinsics.cy) / intrinsics.fy
+        with np.errstate(invalid="ignore"):
+            return depth * (rows[:, None] + cols) + plane.offset
+
+    return memoised(depth, ("heights", intrinsics, plane.key), compute)
 
 
 def footprint_pixels(depth, intrinsics: Intrinsics, plane: Plane, rows, cols) -> np.ndarray:
