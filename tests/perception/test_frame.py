@@ -51,3 +51,18 @@ def test_the_frame_ends_with_its_block_even_on_an_error():
         valid_depth(depth)
         raise RuntimeError
     assert valid_depth(depth) is not valid_depth(depth)
+
+
+def test_what_perception_hands_out_is_the_callers_to_change():
+    # The frame's kept images are read-only; nothing built on them and returned may be.
+    from perception_scenes import CAMERA as SCENE_CAMERA
+    from perception_scenes import render
+
+    from contourgrasp import pipeline
+
+    depth, rgb, _, _ = render(tilt_deg=10.0)
+    seg, metric, _ = pipeline.perceive(rgb, depth, SCENE_CAMERA)
+    support = pipeline.find_objects(depth, SCENE_CAMERA)
+    arrays = [seg.mask, seg.contour_px, seg.plane.inliers, metric.contour_xy, support.plane.inliers,
+              *(c.mask for c in support.candidates)]
+    assert all(a.flags.writeable for a in arrays)
