@@ -8,6 +8,7 @@ from matplotlib.path import Path as MplPath
 
 import contourgrasp as cg
 from contourgrasp import efd, synthesis
+from contourgrasp.hand import to_image
 from contourgrasp.synthesis import _derived, _touch_kernels
 from conftest import disc
 
@@ -23,6 +24,24 @@ def test_centred_three_finger_grasp_on_a_disc_is_symmetric():
     angles = np.arctan2(result.grasp_point[0, :, 1], result.grasp_point[0, :, 0])
     gaps = np.sort(np.diff(np.sort(angles)))
     np.testing.assert_allclose(gaps, 2 * math.pi / 3, atol=1e-2)
+
+
+@pytest.mark.parametrize("chords", [1, 64])
+def test_closest_approach_of_a_finger_passing_beside_a_disc(chords):
+    # The index's ray passes 3 cm from the centre of a 2 cm disc, nearest at its middle: 1 cm gap
+    # there, the nearest contour point on the circle, and that point the caller's own.
+    finger = cg.load_hand("five-finger-linear").fingers[1]
+    model = efd.fit(disc(0.02))
+    a, b = to_image(finger.points(np.array([0.0, finger.travel])), np.zeros(3))
+    direction = (b - a) / np.linalg.norm(b - a)
+    pose = np.r_[0.03 * np.array([-direction[1], direction[0]]) - (a + b) / 2, 0.0]
+    t, lam, point, gap = synthesis.closest_approach(model, finger, pose, chords=chords)
+    assert gap == pytest.approx(0.01, abs=1e-5)
+    assert lam == pytest.approx(finger.travel / 2, abs=1e-3)
+    assert np.linalg.norm(point) == pytest.approx(0.02, abs=1e-5)
+    before = point.copy()
+    point += 1.0
+    np.testing.assert_array_equal(synthesis.closest_approach(model, finger, pose, chords=chords)[2], before)
 
 
 def test_first_touch_matches_brute_force_marching():

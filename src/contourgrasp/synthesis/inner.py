@@ -257,4 +257,4 @@ def closest_approach(model: EFD, finger, pose, samples: int = tol.EFD_SAMPLES, c
     k2, j, s2, gap2 = nearest_point_segment(contour, path[:-1], steps)
     if gap1 <= gap2:
         return float(t[k] + s1 * model.T / samples), float(lam[i]), contour[k] + s1 * edges[k], gap1
-    return float(t[k2]), float(lam[j] + s2 * (lam[j + 1] - lam[j])), contour[k2], gap2
+    return float(t[k2]), float(lam[j] + s2 * (lam[j + 1] - lam[j])), contour[k2].copy(), gap2  # not a view of the shared polygon
