@@ -22,6 +22,9 @@ _MEMO: ContextVar[dict | None] = ContextVar("contourgrasp_perception_frame", def
 def one_frame():
     """Keep the derived images of the frame being perceived until the block ends.
 
+    Its depth images must not change inside the block: their derived images are kept by the
+    array, not by its values.
+
     Examples
     --------
     >>> from contourgrasp.perception import valid_depth

@@ -17,8 +17,8 @@ from .. import validation
 from ..errors import PerceptionError
 from ..tolerances import (MAX_HOLE_PX, MIN_AREA_PX, MIN_HEIGHT, MIN_TABLE_HOLE_PX, PLANE_THRESHOLD, SENSOR_RANGE,
                           TILT_PLANE_THRESHOLD)
-from ._pixels import check_pixel, disc, grown_box, in_image
 from ._frame import memoised
+from ._pixels import check_pixel, disc, grown_box, in_image
 from .camera import Intrinsics, as_depth, check_intrinsics, fill_depth_holes, valid_depth
 from .region import Segmentation, make_segmentation, pick_object
 from .table import Plane, fit_table_plane, footprint_pixels, heights
