@@ -308,7 +308,8 @@ def find_objects(depth, intrinsics: Intrinsics, *, fill_holes: bool = True) -> p
     intrinsics.check_shape(d.shape, "depth image")
     if fill_holes:
         d, _ = perception.fill_depth_holes(d)
-    return perception.find_support(d, intrinsics)
+    with perception.one_frame():
+        return perception.find_support(d, intrinsics)
 
 
 def perceive(
