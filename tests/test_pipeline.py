@@ -188,6 +188,8 @@ def plan_args(tmp_path, **overrides):
     ("no fx", 2, "fx"),
     ("not rigid", 2, "rigid"),
     ("blank", 2, "object"),
+    ("millimetres as float", 2, "median depth 664 m: probably millimetres"),
+    ("scaled twice", 2, "closer than a depth camera measures"),
 ])
 def test_plan_bad_inputs(tmp_path, capsys, case, code, message):
     overrides = {}
@@ -209,6 +211,10 @@ def test_plan_bad_inputs(tmp_path, capsys, case, code, message):
         np.save(tmp_path / "flat.npy", np.full((480, 640), 0.7, np.float32))
         cv2.imwrite(str(tmp_path / "grey.png"), np.full((480, 640, 3), 128, np.uint8))
         overrides.update({"--depth": tmp_path / "flat.npy", "--rgb": tmp_path / "grey.png"})
+    elif case in ("millimetres as float", "scaled twice"):  # the bundled frame in mm, and in km
+        scale = 1e3 if case == "millimetres as float" else 1e-3
+        np.save(tmp_path / "units.npy", np.load(FRAME / "depth_0.npy") * scale)
+        overrides["--depth"] = tmp_path / "units.npy"
     before = set(tmp_path.iterdir())
     result = main(plan_args(tmp_path, **overrides))
     err = capsys.readouterr().err
@@ -216,6 +222,8 @@ def test_plan_bad_inputs(tmp_path, capsys, case, code, message):
     assert result == code
     assert len(lines) == 1 and message in lines[0] and "Traceback" not in err
     assert set(tmp_path.iterdir()) == before
+    if case in ("millimetres as float", "scaled twice"):  # refused, not warned about and then failed
+        assert err.strip() == lines[0]
 
 
 def test_intrinsics_from_shared_format_match_the_bundled_file():

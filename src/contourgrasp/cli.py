@@ -18,7 +18,7 @@ import numpy as np
 
 from . import __version__, synthesize
 from . import contour as efd
-from .errors import InputError, NoFeasibleGrasp, OutputError
+from .errors import InputError, NoFeasibleGrasp, OutputError, UnitWarning
 from .io.contour_file import example_contour, example_names, read_contour
 from .io.hand_file import load_hand, preset_names
 from .io.planner_file import load_planner, planner_names, synthesis_options
@@ -378,13 +378,25 @@ def _synth(args) -> int:
     return EXIT_OK
 
 
+def _read_frame(args):
+    """``plan``'s frame from files. A depth image in other units than meters is refused, not warned about as
+    the library's reader does: no reading of it is inside the sensor's range, so nothing could be planned."""
+    from .io.camera_file import read_rgbd
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", UnitWarning)
+        try:
+            return read_rgbd(args.rgb, args.depth, args.intrinsics, mask_path=args.mask, depth_scale=args.depth_scale)
+        except UnitWarning as unit:
+            raise InputError(str(unit)) from None
+
+
 def _plan(args) -> int:
-    from .io.camera_file import read_extrinsics, read_rgbd
+    from .io.camera_file import read_extrinsics
     from .io.plan_file import image_plan_to_dict
     from .pipeline import plan_frame
 
-    frame = _bag_frame(args) if args.bag else read_rgbd(args.rgb, args.depth, args.intrinsics, mask_path=args.mask,
-                                                        depth_scale=args.depth_scale)
+    frame = _bag_frame(args) if args.bag else _read_frame(args)
     if frame.depth is None:
         raise InputError("plan needs --depth and --intrinsics, or --bag")
     options = {
