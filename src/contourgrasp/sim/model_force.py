@@ -20,7 +20,7 @@ import mujoco  # noqa: E402
 from .. import tolerances as tol  # noqa: E402
 from .. import validation  # noqa: E402
 from ..errors import HandError  # noqa: E402
-from .model_hand import _closing_ends, _free_air, load_model, model_spec  # noqa: E402
+from .model_hand import free_air_closing, load_model, model_spec  # noqa: E402
 
 #: Where along the synergy's ramp :func:`fingertip_forces` reads the forces by default.
 FORCE_PROGRESS = (0.4, 0.6, 0.8)
@@ -73,8 +73,7 @@ def fingertip_forces(model, *, fingertips=None, actuators=None, palm=None, progr
     if not fractions:
         raise HandError("progress must name at least one fraction of the closing")
     m = load_model(spec.path)
-    run, acts, held = _free_air(m, spec, close_time, 0.0)
-    lo, hi, _ = _closing_ends(run, acts, held, spec.path)
+    run, acts, held, lo, hi, _ = free_air_closing(m, spec, close_time, 0.0)
     names = spec.names or spec.fingertips
     settle, ramp, _ = run.steps
     steps = {p: settle + round(p * ramp) for p in fractions}

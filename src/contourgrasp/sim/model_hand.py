@@ -356,10 +356,9 @@ def close_model(spec: ModelSpec, *, close_time: float = 1.0, hold_time: float = 
     source = spec.path
     m = load_model(source)
     collides = (m.geom_contype != 0) | (m.geom_conaffinity != 0)
-    run, acts, held = _free_air(m, spec, close_time, hold_time)
+    run, acts, held, lo, hi, (tips_palm, joint_records, d) = free_air_closing(m, spec, close_time, hold_time)
     palm, tips, chains = run.palm, run.tips, run.chains
     subtree = _subtree(m, palm)
-    lo, hi, (tips_palm, joint_records, d) = _closing_ends(run, acts, held, source)
     moved = np.linalg.norm(tips_palm - tips_palm[:, :1], axis=2).max(axis=1)
     if (still := np.flatnonzero(moved < tol.FINGER_MOVED)).size:
         i = int(still[0])
@@ -389,9 +388,27 @@ def close_model(spec: ModelSpec, *, close_time: float = 1.0, hold_time: float = 
                        palm=None if palm_geoms is None else palm_plate(palm_geoms - shift))
 
 
-def _free_air(m, spec: ModelSpec, close_time: float, hold_time: float) -> tuple[_Run, np.ndarray, list]:
-    """Set ``m`` up for a closing in free air (module docstring) and the run that closes it, with the
-    synergy's actuators and the held ones."""
+def free_air_closing(m, spec: ModelSpec, close_time: float, hold_time: float):
+    """Set ``m`` up for a closing in free air (module docstring) and close it once: (run, actuators, held,
+    open_controls, closed_controls, closing).
+
+    ``run`` (:class:`ClosingRun`) closes the hand again from fresh data when called; ``actuators`` are the
+    synergy's, ``held`` the (actuator, control) pairs kept at their pre-shape; the controls are the
+    synergy's ends (the low ends of the ranges open the hand unless the fingertips end farther apart
+    than they began); ``closing`` is ``run``'s record of the closing from open to closed.
+    """
+    run, acts, held = _free_air(m, spec, close_time, hold_time)
+    lo, hi = run.m.actuator_ctrlrange[acts, 0], run.m.actuator_ctrlrange[acts, 1]
+    closing = run(acts, lo, hi, held, spec.path)
+    if _spread(closing[0][:, -1]) > _spread(closing[0][:, 0]):  # the high ends open the hand: close toward the low
+        lo, hi = hi, lo
+        closing = run(acts, lo, hi, held, spec.path)
+    return run, acts, held, lo, hi, closing
+
+
+def _free_air(m, spec: ModelSpec, close_time: float, hold_time: float) -> tuple[ClosingRun, np.ndarray, list]:
+    """Set ``m`` up for a closing in free air and the run that closes it, with the synergy's actuators and
+    the held ones."""
     source = spec.path
     close_time = validation.bounded("close_time", close_time, tol.MAX_MODEL_CLOSING_TIME, " s", strict=True,
                                     error=HandError)
@@ -404,21 +421,10 @@ def _free_air(m, spec: ModelSpec, close_time: float, hold_time: float) -> tuple[
     tips = [_fingertip(m, name, subtree, source) for name in spec.fingertips]
     acts = _actuators(m, spec.actuators, subtree, source)
     held = _held(m, spec, subtree, source)
-    run = _Run(m, palm, tips, [_moving_path(m, tip, palm) for tip in tips],
+    run = ClosingRun(m, palm, tips, [_moving_path(m, tip, palm) for tip in tips],
                frozen=[j for j in range(m.njnt) if m.jnt_bodyid[j] not in subtree],
                steps=tuple(max(1, round(t / m.opt.timestep)) for t in (SETTLE_TIME, close_time, hold_time)))
     return run, acts, held
-
-
-def _closing_ends(run: _Run, acts, held, source: str):
-    """The synergy's open and closed controls, and the run that closes from one to the other: the low
-    ends of the control ranges open the hand unless the fingertips end farther apart than they began."""
-    lo, hi = run.m.actuator_ctrlrange[acts, 0], run.m.actuator_ctrlrange[acts, 1]
-    closing = run(acts, lo, hi, held, source)
-    if _spread(closing[0][:, -1]) > _spread(closing[0][:, 0]):  # the high ends open the hand: close toward the low
-        lo, hi = hi, lo
-        closing = run(acts, lo, hi, held, source)
-    return lo, hi, closing
 
 
 def _finger_bodies(m, palm: int, tips) -> tuple[tuple[str, int], ...]:
@@ -442,7 +448,7 @@ def _spread(points: np.ndarray) -> float:
 
 
 @dataclass(frozen=True, eq=False)
-class _Run:
+class ClosingRun:
     """One closing of the model from fresh data: settle open, ramp the synergy, hold."""
 
     m: mujoco.MjModel
