@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from functools import partial
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -236,10 +237,11 @@ def plan_frame(
     slicing = bool(slice_contour) if isinstance(slice_contour, np.bool_) else slice_contour  # as flag() took them
     slicing = validation.choice("slice_contour", slicing, SLICE_CONTOUR, error=PlannerError)
     section = perception.cross_section(heights, asked[0]) if slicing is True and asked is not None else None
-    plan = search(metric.contour_xy if section is None else section, hand, descent=spec, **synthesis_options)
-    if slicing == "unbalanced" and asked is not None and not plan.balanced:
-        plan = _balanced_on_section(plan, perception.cross_section(heights, asked[0]), hand, spec, asked[0],
-                                    synthesis_options)
+    on_section = None
+    if slicing == "unbalanced" and asked is not None:
+        on_section = partial(_balanced_on_section, heights, hand, spec, asked[0], synthesis_options)
+    plan = search(metric.contour_xy if section is None else section, hand, descent=spec,
+                  balanced_alternative=on_section, **synthesis_options)
     tip_height = None if asked is None else asked[0] if plan.descent is None else float(plan.descent.tip_height[0])
     depth_at = (metric.approach_depth if tip_height is None
                 else _palm_depth(metric, heights, hand, plan.pose, tip_height))
@@ -258,15 +260,13 @@ NOTE_SECTION = ("no pose balances the squeeze on the outline seen: planned on th
                 "{height:.0f} mm above the table, the height where the fingertips close")
 
 
-def _balanced_on_section(plan, section, hand: Hand, descent, height: float, options):
-    """The plan on ``section`` if a pose balances the squeeze there (the search requires it), else ``plan``
-    (the outline seen's)."""
+def _balanced_on_section(heights: HeightMap, hand: Hand, descent, height: float, options) -> GraspPlan:
+    """The plan on the object's cross-section at ``height`` with a balanced squeeze (the search requires
+    it): the outline seen's ``balanced_alternative``. Raises NoFeasibleGrasp without one, or without a section."""
+    section = perception.cross_section(heights, height)
     if section is None:
-        return plan
-    try:
-        sliced = search(section, hand, descent=descent, balance_required=True, **options)
-    except NoFeasibleGrasp:
-        return plan
+        raise NoFeasibleGrasp("the height map has no cross-section of the object")
+    sliced = search(section, hand, descent=descent, balance_required=True, **options)
     return replace(sliced, search_notes=sliced.search_notes + (NOTE_SECTION.format(height=1000 * height),))
 
 

@@ -22,7 +22,7 @@ import math
 import time
 from dataclasses import replace
 from functools import partial
-from typing import Literal
+from typing import Callable, Literal
 
 import numpy as np
 
@@ -64,6 +64,7 @@ def search(
     quality_gain: float = 0.0,
     max_imbalance: float | Literal["hand"] = 1.0,
     balance_required: bool = False,
+    balanced_alternative: Callable[[], GraspPlan] | None = None,
     small_objects: bool = False,
     descent: Descent | None = None,
 ) -> GraspPlan:
@@ -106,6 +107,13 @@ def search(
         Required instead: no pose balanced within ``max_imbalance`` is no feasible grasp (how
         :func:`contourgrasp.pipeline.plan_frame` searches the cross-section, whose plan it takes only
         when balanced).
+    balanced_alternative : callable, optional
+        Called, once, when no pose balances the squeeze (with the small-object rule's fewer fingers
+        too), before the search gives the balance up (or, with ``balance_required``, fails): the
+        plan it returns is the search's; if it raises NoFeasibleGrasp, the search goes on. Not
+        called while the fingertips cannot reach the object as points: the outline grown by their
+        radius is balanced first. How :func:`contourgrasp.pipeline.plan_frame` turns to the
+        object's cross-section where its outline seen has no balanced pose.
     small_objects : bool
         The small-object rule: when no pose satisfies the constraints with the hand's
         ``min_touching`` fingers, search again with fewer touching fingers, down to
@@ -172,9 +180,11 @@ def search(
     small_objects = check.flag("small_objects", small_objects, error=PlannerError)
     preferred = not check.flag("balance_required", balance_required, error=PlannerError)
     contour = efd_model.clean_polygon(contour_xy)
+    if balanced_alternative is not None and not callable(balanced_alternative):
+        raise PlannerError(f"balanced_alternative must be callable, got {type(balanced_alternative).__name__}")
     outline = partial(_search_outline, hand=hand, grid=grid, safeguards=safeguards, descent=descent,
                       harmonics=harmonics, curvature=curvature, small_objects=small_objects, top_k=top_k,
-                      refine=refine, clock=clock, fallback=preferred)
+                      refine=refine, clock=clock, fallback=preferred, alternative=_Elsewhere(balanced_alternative))
     try:
         return outline(contour)
     except _OutOfReach as points:
@@ -194,10 +204,11 @@ def search(
 
 def _search_outline(contour, *, hand: Hand, grid: SearchGrid, safeguards: Safeguards, descent: Descent | None,
                     harmonics, curvature, small_objects: bool, top_k: int, refine: bool, clock: float,
-                    fallback: bool = True) -> GraspPlan:
+                    fallback: bool = True, alternative: _Elsewhere) -> GraspPlan:
     """:func:`search` on one cleaned outline: fit, screen, then each attempt of the small-object rule and the
-    squeeze's balance in turn (``fallback``: then without the balance). Raises :class:`_OutOfReach` when, with
-    the fewest touching fingers tried, no pose brings them onto the object within their travel."""
+    squeeze's balance in turn, then the ``alternative``'s plan, then (``fallback``) without the balance.
+    Raises :class:`_OutOfReach` when, with the fewest touching fingers tried, no pose brings them onto the
+    object within their travel."""
     if harmonics == "adaptive":
         harmonics = efd_model.choose_harmonics(contour, validate=False)
     model = efd_model.fit(contour, harmonics, validate=False)
@@ -214,6 +225,8 @@ def _search_outline(contour, *, hand: Hand, grid: SearchGrid, safeguards: Safegu
     searched = time.perf_counter()
     errors = []
     for touching, guards in attempts:
+        if guards is not safeguards and (plan := alternative.after(errors[len(counts) - 1])):
+            return plan
         try:
             plan = _search_fitted(model, contour, replace(hand, min_touching=touching),
                                   _needing(screen, touch_counts, touching), grid, guards, descent,
@@ -226,10 +239,31 @@ def _search_outline(contour, *, hand: Hand, grid: SearchGrid, safeguards: Safegu
             note = NOTE_UNBALANCED.format(limit=safeguards.max_imbalance, share=plan.quality.imbalance)
             plan = replace(plan, safeguards=safeguards, search_notes=(note,))
         return plan
+    if safeguards.balances and not fallback and (plan := alternative.after(errors[len(counts) - 1])):
+        return plan
     reason = _no_grasp(errors, len(counts), fewest)
     if isinstance(errors[len(counts) - 1], _OutOfReach):
         raise _OutOfReach(reason, fewest=str(errors[len(counts) - 1]))
     raise NoFeasibleGrasp(reason)
+
+
+class _Elsewhere:
+    """A :func:`search`'s ``balanced_alternative``, called at most once."""
+
+    def __init__(self, plan_elsewhere: Callable[[], GraspPlan] | None):
+        self._plan_elsewhere, self._called, self._plan = plan_elsewhere, plan_elsewhere is None, None
+
+    def after(self, fewest: NoFeasibleGrasp) -> GraspPlan | None:
+        """Its plan once no pose balances, ``fewest`` being why the fewest fingers tried found none; None
+        when it has none (or raised NoFeasibleGrasp), and when they are out of reach: the outline grown
+        by the fingertips' radius is then searched, and balanced first, as its points' cannot be."""
+        if not self._called and not isinstance(fewest, _OutOfReach):
+            self._called = True
+            try:
+                self._plan = self._plan_elsewhere()
+            except NoFeasibleGrasp:
+                pass
+        return self._plan
 
 
 class _OutOfReach(NoFeasibleGrasp):
