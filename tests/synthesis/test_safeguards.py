@@ -154,6 +154,44 @@ def test_a_required_balance_is_no_grasp_where_no_pose_balances_and_the_same_plan
         cg.synthesize(contour, two, balance_required="yes", **FAST)
 
 
+def test_a_balanced_alternative_is_planned_before_the_balance_is_given_up():
+    contour, hand = cg.example_contour("case"), cg.load_hand("five-finger-linear")  # no balanced pose (above)
+    two = dataclasses.replace(hand, min_touching=2)
+    options = {"require_closure": True, "max_imbalance": 0.25, **FAST}
+    elsewhere = cg.synthesize(contour, two, **options)  # stands for another outline's plan
+    calls = []
+
+    def alternative(plan=elsewhere):
+        calls.append(plan)
+        if plan is None:
+            raise NoFeasibleGrasp("none there either")
+        return plan
+
+    assert cg.synthesize(contour, hand, balanced_alternative=alternative, **options) is elsewhere
+    assert cg.synthesize(contour, hand, balanced_alternative=alternative, balance_required=True, **options) is elsewhere
+    assert len(calls) == 2  # once per search
+    calls.clear()
+    unbalanced = cg.synthesize(contour, hand, balanced_alternative=lambda: alternative(None), **options)
+    assert len(calls) == 1 and "planned without it" in unbalanced.notes[0]  # it failed: the search went on
+    np.testing.assert_array_equal(unbalanced.pose, cg.synthesize(contour, hand, **options).pose)
+    calls.clear()
+    balanced = cg.synthesize(contour, two, balanced_alternative=alternative, **options)
+    assert calls == [] and balanced.balanced  # a pose balances on the outline itself: never asked
+    with pytest.raises(InputError, match="balanced_alternative must be callable"):
+        cg.synthesize(contour, hand, balanced_alternative=elsewhere, **options)
+
+
+def test_the_alternative_waits_while_the_fingers_cannot_reach_the_object_as_points():
+    from contourgrasp.synthesis.outer import _Elsewhere, _OutOfReach
+
+    calls = []
+    elsewhere = _Elsewhere(lambda: calls.append(1) or "plan")
+    assert elsewhere.after(_OutOfReach("too small")) is None and calls == []  # the grown outline goes first
+    assert elsewhere.after(NoFeasibleGrasp("unbalanced")) == "plan" == elsewhere.after(NoFeasibleGrasp("again"))
+    assert calls == [1]
+    assert _Elsewhere(None).after(NoFeasibleGrasp("unbalanced")) is None
+
+
 def test_the_no_grasp_reason_names_the_squeeze():
     from contourgrasp.synthesis.evaluate import evaluate_poses
     from contourgrasp.synthesis.outer import _diagnose_exact
