@@ -181,6 +181,18 @@ def test_a_balanced_alternative_is_planned_before_the_balance_is_given_up():
         cg.synthesize(contour, hand, balanced_alternative=elsewhere, **options)
 
 
+def test_a_plan_made_elsewhere_is_not_labelled_as_the_grown_outline_s():
+    theta = np.linspace(0.0, 2 * np.pi, 200, endpoint=False)
+    disc = 0.013 * np.c_[np.cos(theta), np.sin(theta)]  # no two fingertips, as points, close on 26 mm
+    hand, options = cg.load_hand("five-finger-linear"), {"yaw_step": math.radians(10), "xy_step": 0.01}
+    grown = cg.synthesize(disc, hand, small_objects=True, max_imbalance=0.01, **options)
+    assert grown.grown == 0.009 and not grown.balanced  # the balls' outline, no pose balanced there
+    elsewhere = cg.synthesize(cg.example_contour("can"), hand, **options)
+    plan = cg.synthesize(disc, hand, small_objects=True, max_imbalance=0.01, balanced_alternative=lambda: elsewhere,
+                         **options)
+    assert plan is elsewhere and plan.grown == 0.0  # asked for on the grown outline, returned as it came
+
+
 def test_the_alternative_waits_while_the_fingers_cannot_reach_the_object_as_points():
     from contourgrasp.synthesis.outer import _Elsewhere, _OutOfReach
 

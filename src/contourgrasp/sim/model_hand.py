@@ -421,9 +421,9 @@ def _free_air(m, spec: ModelSpec, close_time: float, hold_time: float) -> tuple[
     tips = [_fingertip(m, name, subtree, source) for name in spec.fingertips]
     acts = _actuators(m, spec.actuators, subtree, source)
     held = _held(m, spec, subtree, source)
+    steps = tuple(max(1, round(t / m.opt.timestep)) for t in (SETTLE_TIME, close_time, hold_time))
     run = ClosingRun(m, palm, tips, [_moving_path(m, tip, palm) for tip in tips],
-               frozen=[j for j in range(m.njnt) if m.jnt_bodyid[j] not in subtree],
-               steps=tuple(max(1, round(t / m.opt.timestep)) for t in (SETTLE_TIME, close_time, hold_time)))
+                     frozen=[j for j in range(m.njnt) if m.jnt_bodyid[j] not in subtree], steps=steps)
     return run, acts, held
 
 

@@ -182,9 +182,10 @@ def search(
     contour = efd_model.clean_polygon(contour_xy)
     if balanced_alternative is not None and not callable(balanced_alternative):
         raise PlannerError(f"balanced_alternative must be callable, got {type(balanced_alternative).__name__}")
+    elsewhere = _Elsewhere(balanced_alternative)
     outline = partial(_search_outline, hand=hand, grid=grid, safeguards=safeguards, descent=descent,
                       harmonics=harmonics, curvature=curvature, small_objects=small_objects, top_k=top_k,
-                      refine=refine, clock=clock, fallback=preferred, alternative=_Elsewhere(balanced_alternative))
+                      refine=refine, clock=clock, fallback=preferred, alternative=elsewhere)
     try:
         return outline(contour)
     except _OutOfReach as points:
@@ -198,6 +199,8 @@ def search(
             why = balls.fewest if isinstance(balls, _OutOfReach) else balls.reason
             raise NoFeasibleGrasp(f"{points.reason}; with the fingertips as balls (the outline grown by "
                                   f"{1000 * radius:.1f} mm): {why}") from None
+    if plan is elsewhere.plan:  # planned elsewhere, not on the grown outline
+        return plan
     note = NOTE_BALLS.format(radius=1000 * radius)
     return replace(plan, contour=contour, grown=radius, search_notes=plan.search_notes + (note,))
 
@@ -248,10 +251,10 @@ def _search_outline(contour, *, hand: Hand, grid: SearchGrid, safeguards: Safegu
 
 
 class _Elsewhere:
-    """A :func:`search`'s ``balanced_alternative``, called at most once."""
+    """A :func:`search`'s ``balanced_alternative``, called at most once; ``plan`` is what it returned, if any."""
 
     def __init__(self, plan_elsewhere: Callable[[], GraspPlan] | None):
-        self._plan_elsewhere, self._called, self._plan = plan_elsewhere, plan_elsewhere is None, None
+        self._plan_elsewhere, self._called, self.plan = plan_elsewhere, plan_elsewhere is None, None
 
     def after(self, fewest: NoFeasibleGrasp) -> GraspPlan | None:
         """Its plan once no pose balances, ``fewest`` being why the fewest fingers tried found none; None
@@ -260,10 +263,10 @@ class _Elsewhere:
         if not self._called and not isinstance(fewest, _OutOfReach):
             self._called = True
             try:
-                self._plan = self._plan_elsewhere()
+                self.plan = self._plan_elsewhere()
             except NoFeasibleGrasp:
                 pass
-        return self._plan
+        return self.plan
 
 
 class _OutOfReach(NoFeasibleGrasp):
