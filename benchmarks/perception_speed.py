@@ -51,7 +51,7 @@ import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
 from contourgrasp import perception, pipeline  # noqa: E402
-from contourgrasp.io.camera_file import read_depth, read_intrinsics, read_rgb  # noqa: E402
+from contourgrasp.io.camera_file import read_rgbd  # noqa: E402
 from contourgrasp.sim import build_scene, render  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -78,8 +78,8 @@ def sim_frames(seeds: int):
 
 def bundled_frame():
     """(name, rgb, depth, intrinsics) of the bundled bar-clamp frame."""
-    return ("examples/bar_clamp", read_rgb(BAR_CLAMP / "color_0.png"), read_depth(BAR_CLAMP / "depth_0.npy"),
-            read_intrinsics(BAR_CLAMP / "primesense_overhead_color.intr"))
+    frame = read_rgbd(BAR_CLAMP / "color_0.png", BAR_CLAMP / "depth_0.npy", BAR_CLAMP / "primesense_overhead_color.intr")
+    return "examples/bar_clamp", frame.rgb, frame.depth, frame.intrinsics
 
 
 def stage_times(rgb, depth, intrinsics, clock) -> dict[str, float]:
