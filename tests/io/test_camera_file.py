@@ -91,6 +91,12 @@ def test_depth_in_the_wrong_unit_warns(tmp_path):
     cv2.imwrite(str(tmp_path / "d.png"), np.full((4, 4), 7, np.uint16))
     with pytest.warns(UnitWarning, match="closer than a depth camera measures"):
         read_depth(tmp_path / "d.png")
+    np.save(tmp_path / "tenths.npy", np.full((4, 4), 70_000.0))
+    with pytest.warns(UnitWarning, match=r"median depth 7e\+04 m: probably tenths of millimetres \(scale 0.0001\)"):
+        read_depth(tmp_path / "tenths.npy")
+    np.save(tmp_path / "absurd.npy", np.full((4, 4), 1e300))
+    with pytest.warns(UnitWarning, match="median depth 1e\\+300 m: no depth camera's unit makes that a distance"):
+        read_depth(tmp_path / "absurd.npy")
 
 
 @pytest.mark.parametrize(

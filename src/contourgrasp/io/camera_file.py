@@ -141,11 +141,20 @@ def read_depth(path, *, depth_scale: float = DEPTH_SCALE) -> np.ndarray:
     return depth
 
 
+#: The scales of the integer depth units cameras store (meters per unit), for the unit a depth seems to be in.
+MILLIMETRE, TENTH_MILLIMETRE = 0.001, 0.0001
+
+
 def _check_depth_unit(path, median, scaled):
     hint = "check depth_scale" if scaled else "pass integer millimetres with depth_scale=0.001, or convert to meters"
     if median > tol.MAX_PLAUSIBLE_DEPTH:
-        unit = "millimetres (scale 0.001)" if median < 20_000 else "tenths of millimetres or finer (scale 0.0001)"
-        message = f"median depth {median:.4g} m: probably {unit}; {hint}"
+        if median * MILLIMETRE <= tol.MAX_PLAUSIBLE_DEPTH:
+            unit = "probably millimetres (scale 0.001)"
+        elif median * TENTH_MILLIMETRE <= tol.MAX_PLAUSIBLE_DEPTH:
+            unit = "probably tenths of millimetres (scale 0.0001)"
+        else:  # 1e300 from a corrupt file: naming a scale would send the user looking for the wrong fix
+            unit = "no depth camera's unit makes that a distance it measures"
+        message = f"median depth {median:.4g} m: {unit}; {hint}"
     elif median < tol.MIN_PLAUSIBLE_DEPTH:
         message = f"median depth {median:.4g} m is closer than a depth camera measures: already scaled twice? {hint}"
     else:
