@@ -224,6 +224,7 @@ def test_plan_bad_inputs(tmp_path, capsys, case, code, message):
     assert set(tmp_path.iterdir()) == before
     if case in ("millimetres as float", "scaled twice"):  # refused, not warned about and then failed
         assert err.strip() == lines[0]
+        assert "--depth-scale 0.001" in lines[0] and "depth_scale=" not in lines[0]  # the option a user types
 
 
 def test_intrinsics_from_shared_format_match_the_bundled_file():

@@ -387,8 +387,9 @@ def _read_frame(args):
         warnings.simplefilter("error", UnitWarning)
         try:
             return read_rgbd(args.rgb, args.depth, args.intrinsics, mask_path=args.mask, depth_scale=args.depth_scale)
-        except UnitWarning as unit:
-            raise InputError(str(unit)) from None
+        except UnitWarning as unit:  # the library's hint names its keyword; here the option is what a user types
+            raise InputError(str(unit).replace("depth_scale=", "--depth-scale ").replace(
+                "check depth_scale", "check --depth-scale")) from None
 
 
 def _plan(args) -> int:
