@@ -44,11 +44,13 @@ against the objects present (:func:`contourgrasp.sim.truth_labels`, those
 seen by at least ``MIN_AREA_PX`` pixels): how many were found, and how many
 objects one candidate matches to IoU >= 0.5 (the bin's walls are a candidate
 of their own, matching no object); and the target's IoU with the frame in grey
-(:func:`grey`, a refused frame scoring 0).
+(:func:`grey`, a refused frame scoring 0). ``--worst N`` then lists each kind and
+split's N targets of lowest IoU, with their scenes (seed, camera tilt, target,
+neighbours).
 
 Usage::
 
-    python benchmarks/segmentation.py [--data PATH] [--repeat N] [--sim-seeds N] [--scene-seeds N]
+    python benchmarks/segmentation.py [--data PATH] [--repeat N] [--sim-seeds N] [--scene-seeds N] [--worst N]
 
 ``--data`` defaults to ``$CONTOURGRASP_SHARED_DATA`` or ``../shared/data``
 beside the repository.
@@ -211,8 +213,9 @@ MATCH_IOU = 0.5
 
 
 def rendered_scenes(seeds):
-    """Per (kind, split), one row per scene: target IoU (0 when refused), refused, objects present,
-    candidates found, objects matched by a candidate."""
+    """Per (kind, split), one (row, scene) pair per scene: the row is target IoU (0 when refused), refused,
+    objects present, candidates found, objects matched by a candidate, target IoU in grey; the scene says
+    which it is (seed, camera tilt, target and neighbours)."""
     from contourgrasp.sim.ycb import OBJECT_SETS, load_object
 
     rows = {}
@@ -222,7 +225,10 @@ def rendered_scenes(seeds):
             for seed in range(seeds):
                 target = objects[seed % len(objects)]
                 scene = build_clutter(target, [o for o in objects if o is not target], kind=kind, seed=seed)
-                rows.setdefault((kind, split), []).append(_score_scene(scene, seed))
+                tilt = float(np.degrees(np.arccos(-scene.view[1][2, 2])))
+                about = (f"seed {seed}, tilt {tilt:.1f} deg: {target.name}"
+                         + (f" beside {', '.join(o.name for o in scene.neighbours)}" if scene.neighbours else " alone"))
+                rows.setdefault((kind, split), []).append((_score_scene(scene, seed), about))
     return rows
 
 
@@ -254,8 +260,10 @@ def _score_scene(scene, seed):
     return target_iou, refused, len(present), len(candidates), matched, grey_iou
 
 
-def print_rendered_scenes(seeds) -> None:
-    rows = rendered_scenes(seeds)
+def print_rendered_scenes(seeds, worst: int = 0) -> None:
+    """The scenes' table; with ``worst``, then each kind and split's ``worst`` targets of lowest IoU, one per line."""
+    scenes = rendered_scenes(seeds)
+    rows = {key: [scores for scores, _ in found] for key, found in scenes.items()}
     print(f"\nScenes of several objects ({seeds} per kind and split, the bench's camera tilted 0-25 deg, its depth "
           f"noise): the target given by its pixel, candidates against the objects present\n")
     print(f"| scene | split | target IoU, mean (worst) | targets below {MATCH_IOU} | refused | objects present | "
@@ -266,6 +274,10 @@ def print_rendered_scenes(seeds) -> None:
         print(f"| {kind} | {split} | {a[:, 0].mean():.3f} ({a[:, 0].min():.3f}) | {int((a[:, 0] < MATCH_IOU).sum())} | "
               f"{int(a[:, 1].sum())} | {int(a[:, 2].sum())} | {int(a[:, 3].sum())} | {int(a[:, 4].sum())} | "
               f"{a[:, 5].mean():.3f} ({a[:, 5].min():.3f}) |")
+    for (kind, split), found in scenes.items() if worst > 0 else ():
+        print(f"\nThe {worst} worst targets, {kind}, {split}: IoU (in grey), scene")
+        for scores, about in sorted(found, key=lambda item: item[0][0])[:worst]:
+            print(f"- {scores[0]:.3f} ({scores[5]:.3f}) {about}")
 
 
 def main(argv=None) -> int:
@@ -275,6 +287,8 @@ def main(argv=None) -> int:
     parser.add_argument("--sim-seeds", type=int, default=3, help="placements per simulated object (0: none)")
     parser.add_argument("--scene-seeds", type=int, default=5,
                         help="scenes of several objects per kind and YCB split (0: none)")
+    parser.add_argument("--worst", type=int, default=0,
+                        help="also list each kind and split's WORST targets of lowest IoU, with their scenes")
     args = parser.parse_args(argv)
     rows = list(frames(args.data))
     if rows:
@@ -285,7 +299,7 @@ def main(argv=None) -> int:
     if args.sim_seeds > 0:
         print_simulated(args.sim_seeds)
     if args.scene_seeds > 0:
-        print_rendered_scenes(args.scene_seeds)
+        print_rendered_scenes(args.scene_seeds, args.worst)
     return 0
 
 
