@@ -274,7 +274,9 @@ def print_rendered_scenes(seeds, worst: int = 0) -> None:
         print(f"| {kind} | {split} | {a[:, 0].mean():.3f} ({a[:, 0].min():.3f}) | {int((a[:, 0] < MATCH_IOU).sum())} | "
               f"{int(a[:, 1].sum())} | {int(a[:, 2].sum())} | {int(a[:, 3].sum())} | {int(a[:, 4].sum())} | "
               f"{a[:, 5].mean():.3f} ({a[:, 5].min():.3f}) |")
-    for (kind, split), found in scenes.items() if worst > 0 else ():
+    if worst <= 0:
+        return
+    for (kind, split), found in scenes.items():
         print(f"\nThe {worst} worst targets, {kind}, {split}: IoU (in grey), scene")
         for scores, about in sorted(found, key=lambda item: item[0][0])[:worst]:
             print(f"- {scores[0]:.3f} ({scores[5]:.3f}) {about}")

@@ -190,6 +190,7 @@ def plan_args(tmp_path, **overrides):
     ("blank", 2, "object"),
     ("millimetres as float", 2, "median depth 664 m: probably millimetres"),
     ("scaled twice", 2, "closer than a depth camera measures"),
+    ("integer millimetres at scale 1", 2, "median depth 664 m: probably millimetres (scale 0.001); check --depth-scale"),
 ])
 def test_plan_bad_inputs(tmp_path, capsys, case, code, message):
     overrides = {}
@@ -215,6 +216,9 @@ def test_plan_bad_inputs(tmp_path, capsys, case, code, message):
         scale = 1e3 if case == "millimetres as float" else 1e-3
         np.save(tmp_path / "units.npy", np.load(FRAME / "depth_0.npy") * scale)
         overrides["--depth"] = tmp_path / "units.npy"
+    elif case == "integer millimetres at scale 1":  # a 16-bit PNG in millimetres, read as meters
+        cv2.imwrite(str(tmp_path / "mm.png"), np.round(np.load(FRAME / "depth_0.npy") * 1e3).astype(np.uint16))
+        overrides.update({"--depth": tmp_path / "mm.png", "--depth-scale": 1})
     before = set(tmp_path.iterdir())
     result = main(plan_args(tmp_path, **overrides))
     err = capsys.readouterr().err
@@ -222,9 +226,9 @@ def test_plan_bad_inputs(tmp_path, capsys, case, code, message):
     assert result == code
     assert len(lines) == 1 and message in lines[0] and "Traceback" not in err
     assert set(tmp_path.iterdir()) == before
-    if case in ("millimetres as float", "scaled twice"):  # refused, not warned about and then failed
-        assert err.strip() == lines[0]
-        assert "--depth-scale 0.001" in lines[0] and "depth_scale=" not in lines[0]  # the option a user types
+    if case in ("millimetres as float", "scaled twice", "integer millimetres at scale 1"):  # refused, not warned
+        assert err.strip() == lines[0]                                                      # about and then failed
+        assert "--depth-scale" in lines[0] and "depth_scale" not in lines[0]  # the option a user types
 
 
 def test_intrinsics_from_shared_format_match_the_bundled_file():
