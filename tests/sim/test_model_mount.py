@@ -1,7 +1,8 @@
 import numpy as np
 import pytest
 
-from contourgrasp.sim.model_hand import MODELS, _geom_corners
+from contourgrasp.sim.model_hand import MODELS
+from contourgrasp.sim.model_parts import geom_corners
 from contourgrasp.sim.model_mount import PREFIX, mount_model
 from contourgrasp.sim.objects import soda_can
 from contourgrasp.sim.planners import make_planner
@@ -56,7 +57,7 @@ def test_the_inspire_palm_below_its_frame_is_kept_clear_of_a_tall_object():
     scene.step(0.01)
     origin = scene.palm_pose()[0]
     palm = [scene.model.geom(name).id for name in inspire.geom_names() if name.startswith("palm_")]
-    corners = _geom_corners(scene.model, scene.data, palm, np.zeros(3), np.eye(3))  # world frame
+    corners = geom_corners(scene.model, scene.data, palm, np.zeros(3), np.eye(3))  # world frame
     deepest = corners[np.argmin(corners[:, 2])]
     assert origin[2] - deepest[2] == pytest.approx(inspire.palm_depth, abs=2e-3) and inspire.palm_depth > 0.04
     under = scene.camera.from_world(deepest)[:2] - scene.camera.from_world(origin)[:2]

@@ -20,7 +20,8 @@ import mujoco  # noqa: E402
 from .. import tolerances as tol  # noqa: E402
 from .. import validation  # noqa: E402
 from ..errors import HandError  # noqa: E402
-from .model_hand import free_air_closing, load_model, model_spec  # noqa: E402
+from .model_hand import free_air_closing, model_spec  # noqa: E402
+from .model_parts import load_model  # noqa: E402
 
 #: Where along the synergy's ramp :func:`fingertip_forces` reads the forces by default.
 FORCE_PROGRESS = (0.4, 0.6, 0.8)

@@ -60,6 +60,9 @@ its chains and palm only when every finger has a chain; otherwise it is a 2-D ha
 :attr:`Derivation.notes` says why. Finger radius: half the smallest extent of the
 fingertip body's collision geoms.
 
+*Parts.* The palm, the fingertips, the actuators, the hinge chains and the geoms' boxes are found by
+name in :mod:`contourgrasp.sim.model_parts`, which refuses a name the model does not have.
+
 *Forces* (:func:`contourgrasp.sim.model_force.fingertip_forces`, not part of the hand file): how hard
 each fingertip pushes along its path during the same closing, read from the drives' joint forces.
 
@@ -84,9 +87,9 @@ from .. import tolerances as tol  # noqa: E402
 from .. import validation  # noqa: E402
 from ..errors import HandError, HandFileError, SimulationError  # noqa: E402
 from ..hand import Hand, Palm, SampledChain  # noqa: E402
+from . import model_parts as parts  # noqa: E402
 from .calibrate import Closing, derive_virtual_starts  # noqa: E402
-from .model_fit import (BOX_CORNERS, FingerFit, fit_chain, fit_finger, palm_plate, sampled_chain,  # noqa: E402
-                        travelled)
+from .model_fit import FingerFit, fit_chain, fit_finger, palm_plate, sampled_chain, travelled  # noqa: E402
 from .scene import TIMESTEP, mujoco_warnings  # noqa: E402
 
 #: Time the open hand settles before closing, s.
@@ -284,19 +287,6 @@ class ClosedModel:
     mount: Mount
 
 
-def load_model(path) -> mujoco.MjModel:
-    """The compiled MuJoCo model of an MJCF file; HandFileError naming the file when it cannot load."""
-    path = Path(path)
-    if not path.is_file():
-        raise HandFileError(f"{path}: no such model file")
-    try:
-        with mujoco_warnings():
-            return mujoco.MjModel.from_xml_path(str(path))
-    except (ValueError, RuntimeError) as err:
-        reason = " ".join(str(err).split())[:300]
-        raise HandFileError(f"{path}: cannot load the MuJoCo model ({reason})") from None
-
-
 def derive_hand(model, *, fingertips=None, actuators=None, palm=None, approach=None, max_imbalance=None,
                 tips_brush_table=None, name: str | None = None, close_time: float = 1.0,
                 hold_time: float = 0.5) -> Derivation:
@@ -354,11 +344,11 @@ def _min_touching(n: int) -> int:
 def close_model(spec: ModelSpec, *, close_time: float = 1.0, hold_time: float = 0.5) -> ClosedModel:
     """Load, fix the palm, close the synergy in free air and record the fingertips (module docstring)."""
     source = spec.path
-    m = load_model(source)
+    m = parts.load_model(source)
     collides = (m.geom_contype != 0) | (m.geom_conaffinity != 0)
     run, acts, held, lo, hi, (tips_palm, joint_records, d) = free_air_closing(m, spec, close_time, hold_time)
     palm, tips, chains = run.palm, run.tips, run.chains
-    subtree = _subtree(m, palm)
+    subtree = parts.subtree(m, palm)
     moved = np.linalg.norm(tips_palm - tips_palm[:, :1], axis=2).max(axis=1)
     if (still := np.flatnonzero(moved < tol.FINGER_MOVED)).size:
         i = int(still[0])
@@ -371,7 +361,7 @@ def close_model(spec: ModelSpec, *, close_time: float = 1.0, hold_time: float = 
         axes = _levelled(axes, tips_palm[:, 0], source) if spec.approach == LEVEL else axes
     else:
         axes = _hand_axes(_axis(spec.approach, source)[None])
-    palm_geoms = _palm_geoms(m, d, palm, subtree, axes, collides)
+    palm_geoms = parts.palm_geoms(m, d, palm, subtree, axes, collides)
     knuckles = [float(joint_records[i][0, 0] @ axes[2]) for i, c in enumerate(chains) if len(c)]
     depth = 0.0 if palm_geoms is None else min([float(palm_geoms[:, 2].max())] + knuckles)
     shift = np.array([0.0, 0.0, depth])
@@ -379,12 +369,12 @@ def close_model(spec: ModelSpec, *, close_time: float = 1.0, hold_time: float = 
     mount = Mount(palm=m.body(palm).name, rotation=tuple(map(tuple, axes.tolist())), position=tuple(-shift),
                   actuators=tuple(m.actuator(a).name for a in acts), open_controls=tuple(lo.tolist()),
                   closed_controls=tuple(hi.tolist()), held=tuple((m.actuator(a).name, v) for a, v in held),
-                  finger_bodies=_finger_bodies(m, palm, tips), tip_depth=float(tips_hand[:, :, 2].max()),
+                  finger_bodies=parts.finger_bodies(m, palm, tips), tip_depth=float(tips_hand[:, :, 2].max()),
                   palm_depth=0.0 if palm_geoms is None else max(0.0, float(palm_geoms[:, 2].max()) - depth))
     return ClosedModel(names=tuple(spec.names or spec.fingertips), times=m.opt.timestep * np.arange(tips_palm.shape[1]),
                        tips=tips_hand, mount=mount,
                        joints=tuple(np.transpose(j, (1, 0, 2)) @ axes.T - shift for j in joint_records),
-                       radius=np.array([_tip_radius(m, t, collides) for t in tips]),
+                       radius=np.array([parts.tip_radius(m, t, collides) for t in tips]),
                        palm=None if palm_geoms is None else palm_plate(palm_geoms - shift))
 
 
@@ -416,30 +406,15 @@ def _free_air(m, spec: ModelSpec, close_time: float, hold_time: float) -> tuple[
     m.opt.gravity[:] = 0.0
     m.opt.timestep, m.opt.integrator = TIMESTEP, mujoco.mjtIntegrator.mjINT_IMPLICITFAST  # the scene's
     m.geom_contype[:] = m.geom_conaffinity[:] = 0  # free air: nothing to touch, fingers pass each other (as in the scene)
-    palm = _palm_body(m, spec, source)
-    subtree = _subtree(m, palm)
-    tips = [_fingertip(m, name, subtree, source) for name in spec.fingertips]
-    acts = _actuators(m, spec.actuators, subtree, source)
-    held = _held(m, spec, subtree, source)
+    palm = parts.palm_body(m, spec.palm, spec.fingertips, source)
+    subtree = parts.subtree(m, palm)
+    tips = [parts.fingertip(m, name, subtree, source) for name in spec.fingertips]
+    acts = parts.actuators(m, spec.actuators, subtree, source)
+    held = parts.held_controls(m, spec.hold, subtree, source)
     steps = tuple(max(1, round(t / m.opt.timestep)) for t in (SETTLE_TIME, close_time, hold_time))
-    run = ClosingRun(m, palm, tips, [_moving_path(m, tip, palm) for tip in tips],
+    run = ClosingRun(m, palm, tips, [parts.moving_path(m, tip, palm) for tip in tips],
                      frozen=[j for j in range(m.njnt) if m.jnt_bodyid[j] not in subtree], steps=steps)
     return run, acts, held
-
-
-def _finger_bodies(m, palm: int, tips) -> tuple[tuple[str, int], ...]:
-    """Each body below the palm that lies on a finger (toward its tip, or below such a body), with the finger."""
-    owner = {}
-    for i, tip in enumerate(tips):
-        body = _tip_body(m, tip)
-        while body != palm:
-            owner.setdefault(body, i)
-            body = int(m.body_parentid[body])
-    for b in range(palm + 1, m.nbody):  # depth first: a parent before its children
-        parent = int(m.body_parentid[b])
-        if b not in owner and parent in owner:
-            owner[b] = owner[parent]
-    return tuple((m.body(b).name, i) for b, i in sorted(owner.items()))
 
 
 def _spread(points: np.ndarray) -> float:
@@ -471,139 +446,19 @@ class ClosingRun:
             for k in range(settle + ramp + hold + 1):
                 u = min(1.0, max(0.0, (k - settle) / ramp))
                 d.ctrl[acts] = open_ctrl + u * (closed_ctrl - open_ctrl)
-                _freeze(m, d, self.frozen)
+                parts.freeze(m, d, self.frozen)
                 mujoco.mj_step(m, d) if k else mujoco.mj_forward(m, d)
                 if probe is not None:
                     probe(k, d)
                 if k >= settle:
                     position, rotation = d.xpos[self.palm].copy(), d.xmat[self.palm].reshape(3, 3).copy()
-                    records.append([(_point(d, t) - position) @ rotation for t in self.tips])
+                    records.append([(parts.tip_point(d, t) - position) @ rotation for t in self.tips])
                     joint_records.append([(d.xanchor[c] - position) @ rotation for c in self.chains])
         if d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number > 0 or not np.isfinite(np.asarray(records)).all():
             raise SimulationError(f"{source}: the model is unstable while closing (NaN or huge accelerations)")
         joints = [np.asarray([r[i] for r in joint_records]).reshape(len(records), len(c), 3)
                   for i, c in enumerate(self.chains)]
         return np.transpose(np.asarray(records), (1, 0, 2)), joints, d
-
-
-def _held(m, spec: ModelSpec, subtree: set[int], source: str) -> list[tuple[int, float]]:
-    """Actuators held still at a fraction of their control range (a pre-shape), as (id, control)."""
-    held = []
-    for name, fraction in spec.hold:
-        a = _actuators(m, (name,), subtree, source)[0]
-        lo, hi = m.actuator_ctrlrange[a]
-        held.append((int(a), float(lo + fraction * (hi - lo))))
-    return held
-
-
-def _palm_body(m, spec: ModelSpec, source: str) -> int:
-    if spec.palm is not None:
-        body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, spec.palm)
-        if body < 0:
-            kind = next((label for label, obj in (("a site", mujoco.mjtObj.mjOBJ_SITE), ("a geom", mujoco.mjtObj.mjOBJ_GEOM),
-                                                  ("a joint", mujoco.mjtObj.mjOBJ_JOINT))
-                         if mujoco.mj_name2id(m, obj, spec.palm) >= 0), "not a name in the model")
-            raise HandFileError(f"{source}: palm {spec.palm!r} is not a body ({kind})")
-        return body
-    paths = []
-    for name in spec.fingertips:
-        body = _fingertip_body(m, name, source)
-        path = [body]
-        while path[-1] != 0:
-            path.append(int(m.body_parentid[path[-1]]))
-        paths.append(path[::-1])
-    common = 0
-    for level in zip(*paths, strict=False):
-        if len(set(level)) != 1:
-            break
-        common = level[0]
-    if common == 0:
-        raise HandFileError(f"{source}: the fingertips share no body but the world; name the palm body (--palm)")
-    return common
-
-
-def _subtree(m, body: int) -> set[int]:
-    inside = {body}
-    for b in range(body + 1, m.nbody):  # MuJoCo numbers bodies depth first: children after parents
-        if int(m.body_parentid[b]) in inside:
-            inside.add(b)
-    return inside
-
-
-def _fingertip_body(m, name: str, source: str) -> int:
-    site = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, name)
-    if site >= 0:
-        return int(m.site_bodyid[site])
-    body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, name)
-    if body < 0:
-        raise HandFileError(f"{source}: fingertips: no site or body named {name!r} in the model")
-    return body
-
-
-def _fingertip(m, name: str, subtree: set[int], source: str) -> tuple[str, int]:
-    body = _fingertip_body(m, name, source)
-    if body not in subtree:
-        raise HandFileError(f"{source}: fingertips: {name!r} is not on a finger of the palm body")
-    site = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, name)
-    return ("site", site) if site >= 0 else ("body", body)
-
-
-def _point(d, tip: tuple[str, int]) -> np.ndarray:
-    kind, index = tip
-    return d.site_xpos[index].copy() if kind == "site" else d.xpos[index].copy()
-
-
-def _tip_body(m, tip: tuple[str, int]) -> int:
-    kind, index = tip
-    return int(m.site_bodyid[index]) if kind == "site" else index
-
-
-def _actuators(m, names, subtree: set[int], source: str) -> np.ndarray:
-    def on_hand(a: int) -> bool:
-        kind, target = int(m.actuator_trntype[a]), int(m.actuator_trnid[a, 0])
-        if kind in (mujoco.mjtTrn.mjTRN_JOINT, mujoco.mjtTrn.mjTRN_JOINTINPARENT):
-            return int(m.jnt_bodyid[target]) in subtree
-        return True  # tendons, sites, bodies: taken as the hand's
-
-    if names is None or list(names) == ["all"]:
-        chosen = [a for a in range(m.nu) if on_hand(a)]
-        if not chosen:
-            raise HandFileError(f"{source}: actuators: the model has no actuator on the palm's subtree")
-    else:
-        chosen = []
-        for name in names:
-            a = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, name)
-            if a < 0:
-                known = ", ".join(m.actuator(i).name for i in range(m.nu)) or "none"
-                raise HandFileError(f"{source}: actuators: no actuator named {name!r} (the model's: {known})")
-            if not on_hand(a):
-                raise HandFileError(f"{source}: actuators: {name!r} drives a joint outside the palm's subtree")
-            chosen.append(a)
-    for a in chosen:
-        lo, hi = m.actuator_ctrlrange[a]
-        if not m.actuator_ctrllimited[a] or not lo < hi:
-            raise HandFileError(f"{source}: actuators: {m.actuator(a).name!r} has no control range (ctrlrange): "
-                                "the synergy drives each actuator from the low end of its range to the high end")
-    return np.array(chosen, dtype=int)
-
-
-def _freeze(m, d, joints) -> None:
-    """Hold the joints outside the palm's subtree at their reference position, at rest."""
-    for j in joints:
-        q, v = int(m.jnt_qposadr[j]), int(m.jnt_dofadr[j])
-        nq, nv = {mujoco.mjtJoint.mjJNT_FREE: (7, 6), mujoco.mjtJoint.mjJNT_BALL: (4, 3)}.get(int(m.jnt_type[j]), (1, 1))
-        d.qpos[q:q + nq] = m.qpos0[q:q + nq]
-        d.qvel[v:v + nv] = 0.0
-
-
-def _moving_path(m, tip: tuple[str, int], palm: int) -> list[int]:
-    """Hinge joints from the palm to the fingertip's body, palm side first."""
-    joints, body = [], _tip_body(m, tip)
-    while body != palm:
-        adr, count = int(m.body_jntadr[body]), int(m.body_jntnum[body])
-        joints = [j for j in range(adr, adr + count) if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE] + joints
-        body = int(m.body_parentid[body])
-    return joints
 
 
 def _axis(name: str, source: str) -> np.ndarray:
@@ -640,43 +495,6 @@ def _hand_axes(pointing: np.ndarray) -> np.ndarray:
     z[k] = np.sign(mean[k]) or 1.0
     x = np.eye(3)[0 if k else 1]
     return np.stack([x, np.cross(z, x), z])
-
-
-def _local_corners(m, g: int) -> np.ndarray:
-    """(8, 3) float: the corners of geom ``g``'s bounding box in its own frame."""
-    return m.geom_aabb[g, :3] + BOX_CORNERS * m.geom_aabb[g, 3:]
-
-
-def _geom_corners(m, d, geoms, origin: np.ndarray, rotation: np.ndarray) -> np.ndarray:
-    """(8 g, 3) float: the corners of each geom's local bounding box, in the frame (origin, rotation)."""
-    return np.concatenate([(_local_corners(m, g) @ d.geom_xmat[g].reshape(3, 3).T + d.geom_xpos[g] - origin) @ rotation
-                           for g in geoms])
-
-
-def _palm_geoms(m, d, palm: int, subtree: set[int], axes: np.ndarray, collides: np.ndarray) -> np.ndarray | None:
-    """Corners of the palm's own collision geoms (bodies welded to it), hand axes, palm origin; None if none."""
-    weld = int(m.body_weldid[palm])
-    geoms = [g for g in range(m.ngeom) if int(m.geom_bodyid[g]) in subtree
-             and int(m.body_weldid[m.geom_bodyid[g]]) == weld and collides[g]]
-    if not geoms:
-        return None
-    rotation = d.xmat[palm].reshape(3, 3)
-    return _geom_corners(m, d, geoms, d.xpos[palm], rotation) @ axes.T
-
-
-def _tip_radius(m, tip: tuple[str, int], collides: np.ndarray) -> float:
-    """Half the smallest extent of the fingertip body's collision geoms, in that body's frame; 0 without any."""
-    body = _tip_body(m, tip)
-    geoms = [g for g in range(m.ngeom) if int(m.geom_bodyid[g]) == body and collides[g]]
-    if not geoms:
-        return 0.0
-    corners = []
-    for g in geoms:
-        rotation = np.empty(9)
-        mujoco.mju_quat2Mat(rotation, m.geom_quat[g])
-        corners.append(_local_corners(m, g) @ rotation.reshape(3, 3).T + m.geom_pos[g])
-    points = np.concatenate(corners)
-    return float(np.ptp(points, axis=0).min() / 2)
 
 
 def _with_virtual_starts(hand: Hand, closed: ClosedModel) -> Hand:
