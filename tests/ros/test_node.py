@@ -269,6 +269,28 @@ def test_the_ros_command_serves_plan_and_stops_on_ctrl_c(ros):
         camera.node.destroy_node()
 
 
+#: The node's ``main`` with a spin that, as rclpy's signal handler can on a Ctrl-C, finds the context shut down
+#: between two waits (ros2/rclpy#398): the next wait set then raises RCLError.
+RACING_CTRL_C = """
+import sys, rclpy
+from rclpy.executors import SingleThreadedExecutor
+def spin(node):
+    executor = SingleThreadedExecutor(context=node.context)
+    executor.add_node(node)
+    rclpy.shutdown(context=node.context)
+    executor.spin_once()
+rclpy.spin = spin
+from contourgrasp.ros import node
+sys.exit(node.main())
+"""
+
+
+def test_a_ctrl_c_that_shuts_the_context_down_mid_spin_still_exits_0():
+    done = subprocess.run([sys.executable, "-c", RACING_CTRL_C], capture_output=True, text=True, timeout=TIMEOUT)
+    assert done.returncode == 0, done.stderr
+    assert "ready" in done.stderr and "Traceback" not in done.stderr
+
+
 def test_the_ros_command_without_the_extra_says_install_it(monkeypatch, capsys):
     monkeypatch.setitem(sys.modules, "rclpy", None)
     monkeypatch.delitem(sys.modules, "contourgrasp.ros.node")

@@ -278,6 +278,9 @@ def main(ros_args=()) -> int:
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
+    except RuntimeError:  # rclpy's RCLError: rclpy's signal handler shuts the context down while the spin makes
+        if rclpy.ok():    # its next wait set, a race of Ctrl-C (ros2/rclpy#398); any other error is the node's
+            raise
     finally:
         _ignore_interrupts()
         node.destroy_node()
