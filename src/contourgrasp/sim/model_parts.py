@@ -82,10 +82,10 @@ def fingertip_body(m, name: str, source: str) -> int:
     return body
 
 
-def fingertip(m, name: str, subtree: set[int], source: str) -> tuple[str, int]:
-    """The fingertip ``name`` as ("site", id) or ("body", id), refused unless it lies on ``subtree`` (the palm's)."""
+def fingertip(m, name: str, palm_bodies: set[int], source: str) -> tuple[str, int]:
+    """The fingertip ``name`` as ("site", id) or ("body", id), refused unless it lies on ``palm_bodies`` (the palm's subtree)."""
     body = fingertip_body(m, name, source)
-    if body not in subtree:
+    if body not in palm_bodies:
         raise HandFileError(f"{source}: fingertips: {name!r} is not on a finger of the palm body")
     site = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, name)
     return ("site", site) if site >= 0 else ("body", body)
@@ -128,14 +128,14 @@ def moving_path(m, tip: tuple[str, int], palm: int) -> list[int]:
     return joints
 
 
-def actuators(m, names, subtree: set[int], source: str) -> np.ndarray:
-    """The ids of the actuators ``names`` (None or ["all"]: every one on ``subtree``), each on the hand and with a
+def actuators(m, names, palm_bodies: set[int], source: str) -> np.ndarray:
+    """The ids of the actuators ``names`` (None or ["all"]: every one on ``palm_bodies``), each on the hand and with a
     control range."""
 
     def on_hand(a: int) -> bool:
         kind, target = int(m.actuator_trntype[a]), int(m.actuator_trnid[a, 0])
         if kind in (mujoco.mjtTrn.mjTRN_JOINT, mujoco.mjtTrn.mjTRN_JOINTINPARENT):
-            return int(m.jnt_bodyid[target]) in subtree
+            return int(m.jnt_bodyid[target]) in palm_bodies
         return True  # tendons, sites, bodies: taken as the hand's
 
     if names is None or list(names) == ["all"]:
@@ -160,12 +160,12 @@ def actuators(m, names, subtree: set[int], source: str) -> np.ndarray:
     return np.array(chosen, dtype=int)
 
 
-def held_controls(m, hold, subtree: set[int], source: str) -> list[tuple[int, float]]:
+def held_controls(m, hold, palm_bodies: set[int], source: str) -> list[tuple[int, float]]:
     """The actuators of ``hold`` ((name, fraction) pairs) held still at that fraction of their control range (a
     pre-shape), as (id, control)."""
     held = []
     for name, fraction in hold:
-        a = actuators(m, (name,), subtree, source)[0]
+        a = actuators(m, (name,), palm_bodies, source)[0]
         lo, hi = m.actuator_ctrlrange[a]
         held.append((int(a), float(lo + fraction * (hi - lo))))
     return held
@@ -191,10 +191,10 @@ def geom_corners(m, d, geoms, origin: np.ndarray, rotation: np.ndarray) -> np.nd
                            for g in geoms])
 
 
-def palm_geoms(m, d, palm: int, subtree: set[int], axes: np.ndarray, collides: np.ndarray) -> np.ndarray | None:
+def palm_geoms(m, d, palm: int, palm_bodies: set[int], axes: np.ndarray, collides: np.ndarray) -> np.ndarray | None:
     """Corners of the palm's own collision geoms (bodies welded to it), hand axes, palm origin; None if none."""
     weld = int(m.body_weldid[palm])
-    geoms = [g for g in range(m.ngeom) if int(m.geom_bodyid[g]) in subtree
+    geoms = [g for g in range(m.ngeom) if int(m.geom_bodyid[g]) in palm_bodies
              and int(m.body_weldid[m.geom_bodyid[g]]) == weld and collides[g]]
     if not geoms:
         return None
