@@ -92,7 +92,7 @@ def test_actuators_are_the_hands_with_a_control_range(model):
     assert [model.actuator(a).name for a in named] == ["left_drive", "right_drive"]
     with pytest.raises(HandFileError, match="'free_drive' has no control range"):
         parts.actuators(model, None, subtree, "hand.xml")  # all on the hand, one of them without a range
-    with pytest.raises(HandFileError, match="no actuator named 'grip' \\(the model's: left_drive, right_drive, free_drive\\)"):
+    with pytest.raises(HandFileError, match="no actuator named 'grip' \\(the model's: left_drive, right_drive"):
         parts.actuators(model, ("grip",), subtree, "hand.xml")
     assert parts.held_controls(model, (("right_drive", 0.75),), subtree, "hand.xml") == [(1, pytest.approx(0.5))]
 
@@ -103,6 +103,7 @@ def test_geom_corners_are_the_box_turned_and_placed(model):
     plate = model.geom("plate").id
     corners = parts.geom_corners(model, data, [plate], data.xpos[_body(model, "palm")], np.eye(3))
     c, s = np.cos(0.5), np.sin(0.5)
-    half = np.array([[0.04, 0.03, 0.005]]) * np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+    half = np.array([[0.04, 0.03, 0.005]]) * signs
     expected = half @ np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]).T
     assert sorted(map(tuple, np.round(corners, 9))) == sorted(map(tuple, np.round(expected, 9)))

@@ -83,7 +83,8 @@ def fingertip_body(m, name: str, source: str) -> int:
 
 
 def fingertip(m, name: str, palm_bodies: set[int], source: str) -> tuple[str, int]:
-    """The fingertip ``name`` as ("site", id) or ("body", id), refused unless it lies on ``palm_bodies`` (the palm's subtree)."""
+    """The fingertip ``name`` as ("site", id) or ("body", id), refused unless it lies on ``palm_bodies`` (the
+    palm's subtree)."""
     body = fingertip_body(m, name, source)
     if body not in palm_bodies:
         raise HandFileError(f"{source}: fingertips: {name!r} is not on a finger of the palm body")
