@@ -219,31 +219,33 @@ def _search_outline(contour, *, hand: Hand, grid: SearchGrid, safeguards: Safegu
     fewest = max(tol.SMALL_OBJECT_TOUCHING, sum(f.required for f in hand.fingers))
     fewest = min(fewest, hand.min_touching) if small_objects else hand.min_touching
     counts = range(hand.min_touching, fewest - 1, -1)
-    attempts = [(touching, safeguards) for touching in counts]
-    if safeguards.balances and fallback:  # a balanced squeeze is preferred, not required: then the thesis's best pose
-        attempts += [(touching, replace(safeguards, max_imbalance=1.0)) for touching in counts]
     screen = screen_grid(model, replace(hand, min_touching=fewest), grid, curvature=curvature)
     touch_counts = np.count_nonzero(screen.touching, axis=1)
     share = np.full(len(screen.poses), np.nan)  # the squeeze's balance per screened pose, filled as attempts need it
     searched = time.perf_counter()
     errors = []
-    for touching, guards in attempts:
-        if guards is not safeguards and (plan := alternative.after(errors[len(counts) - 1])):
+
+    def attempt(guards: Safeguards) -> GraspPlan | None:
+        """The plan of the first of the small-object rule's counts that has one under ``guards``; None when none
+        has (each failure kept in ``errors``, its reason worked out only if every attempt fails: _Unexplained)."""
+        for touching in counts:
+            try:
+                return _search_fitted(model, contour, replace(hand, min_touching=touching),
+                                      _needing(screen, touch_counts, touching), grid, guards, descent,
+                                      curvature=curvature, top_k=top_k, refine=refine,
+                                      times=(clock, fitted, searched), share=share)
+            except NoFeasibleGrasp as err:
+                errors.append(err)
+        return None
+
+    if (plan := attempt(safeguards)) is not None:
+        return plan
+    if safeguards.balances:  # a balanced squeeze is preferred: elsewhere's, else (fallback) the thesis's best pose
+        if (plan := alternative.after(errors[-1])) is not None:
             return plan
-        try:
-            plan = _search_fitted(model, contour, replace(hand, min_touching=touching),
-                                  _needing(screen, touch_counts, touching), grid, guards, descent,
-                                  curvature=curvature, top_k=top_k, refine=refine, times=(clock, fitted, searched),
-                                  share=share)
-        except NoFeasibleGrasp as err:
-            errors.append(err)  # its reason worked out only if every attempt fails (_Unexplained)
-            continue
-        if guards is not safeguards:
+        if fallback and (plan := attempt(replace(safeguards, max_imbalance=1.0))) is not None:
             note = NOTE_UNBALANCED.format(limit=safeguards.max_imbalance, share=plan.quality.imbalance)
-            plan = replace(plan, safeguards=safeguards, search_notes=(note,))
-        return plan
-    if safeguards.balances and not fallback and (plan := alternative.after(errors[len(counts) - 1])):
-        return plan
+            return replace(plan, safeguards=safeguards, search_notes=(note,))
     reason = _no_grasp(errors, len(counts), fewest)
     if isinstance(errors[len(counts) - 1], _OutOfReach):
         raise _OutOfReach(reason, fewest=str(errors[len(counts) - 1]))
