@@ -18,7 +18,7 @@ import numpy as np
 
 from . import __version__, synthesize
 from . import contour as efd
-from .errors import InputError, NoFeasibleGrasp, OutputError, UnitWarning
+from .errors import DepthUnitWarning, InputError, NoFeasibleGrasp, OutputError
 from .io.contour_file import example_contour, example_names, read_contour
 from .io.hand_file import load_hand, preset_names
 from .io.planner_file import load_planner, planner_names, synthesis_options
@@ -384,12 +384,11 @@ def _read_frame(args):
     from .io.camera_file import read_rgbd
 
     with warnings.catch_warnings():
-        warnings.simplefilter("error", UnitWarning)
+        warnings.simplefilter("error", DepthUnitWarning)
         try:
             return read_rgbd(args.rgb, args.depth, args.intrinsics, mask_path=args.mask, depth_scale=args.depth_scale)
-        except UnitWarning as unit:  # the library's hint names its keyword; here the option is what a user types
-            raise InputError(str(unit).replace("depth_scale=", "--depth-scale ").replace(
-                "check depth_scale", "check --depth-scale")) from None
+        except DepthUnitWarning as unit:
+            raise InputError(unit.advice("--depth-scale", " ")) from None
 
 
 def _plan(args) -> int:

@@ -25,6 +25,7 @@ area under one root)::
 
     ContourGraspWarning (UserWarning)
     ├── UnitWarning                    a magnitude that suggests non-SI units
+    │   └── DepthUnitWarning           a depth image whose readings are not meters (its fix named)
     └── PerceptionWarning              a usable but doubtful perception result
 """
 
@@ -108,6 +109,40 @@ class ContourGraspWarning(UserWarning):
 
 class UnitWarning(ContourGraspWarning):
     """Input whose magnitude suggests it is not in SI units."""
+
+
+class DepthUnitWarning(UnitWarning):
+    """A depth image whose median reading is implausible in meters.
+
+    The fix it names is the depth scale option, which a library caller spells ``depth_scale=`` and
+    a command line ``--depth-scale``: :meth:`advice` words it for either, ``str()`` for the library.
+
+    Attributes
+    ----------
+    path : str
+        The depth file.
+    diagnosis : str
+        What the median says, e.g. ``"median depth 612 m: probably millimetres (scale 0.001)"``.
+    scaled : bool
+        The file held integers, already multiplied by the scale given.
+    """
+
+    def __init__(self, path, diagnosis: str, scaled: bool):
+        self.path, self.diagnosis, self.scaled = str(path), diagnosis, bool(scaled)
+        super().__init__(self.advice())
+
+    def advice(self, option: str = "depth_scale", assign: str = "=") -> str:
+        """The one-line message, the scale option named ``option`` and set with ``assign``.
+
+        Examples
+        --------
+        >>> DepthUnitWarning("d.png", "median depth 700 m: probably millimetres (scale 0.001)", True).advice(
+        ...     "--depth-scale", " ")
+        'd.png: median depth 700 m: probably millimetres (scale 0.001); check --depth-scale'
+        """
+        fix = (f"check {option}" if self.scaled
+               else f"pass integer millimetres with {option}{assign}0.001, or convert to meters")
+        return f"{self.path}: {self.diagnosis}; {fix}"
 
 
 class PerceptionWarning(ContourGraspWarning):

@@ -13,7 +13,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from contourgrasp.errors import InputError, UnitWarning
+from contourgrasp.errors import DepthUnitWarning, InputError, UnitWarning
 from contourgrasp.io.camera_file import (
     Intrinsics,
     read_depth,
@@ -97,6 +97,21 @@ def test_depth_in_the_wrong_unit_warns(tmp_path):
     np.save(tmp_path / "absurd.npy", np.full((4, 4), 1e300))
     with pytest.warns(UnitWarning, match="median depth 1e\\+300 m: no depth camera's unit makes that a distance"):
         read_depth(tmp_path / "absurd.npy")
+
+
+def test_a_depth_unit_warning_names_the_scale_option_as_its_caller_spells_it(tmp_path):
+    np.save(tmp_path / "mm.npy", np.full((4, 4), 700.0))
+    cv2.imwrite(str(tmp_path / "mm.png"), np.full((4, 4), 700, np.uint16))
+    with pytest.warns(DepthUnitWarning) as floats:
+        read_depth(tmp_path / "mm.npy")
+    with pytest.warns(DepthUnitWarning) as integers:
+        read_depth(tmp_path / "mm.png", depth_scale=1.0)
+    floats, integers = floats[0].message, integers[0].message
+    assert str(floats).endswith("; pass integer millimetres with depth_scale=0.001, or convert to meters")
+    assert floats.advice("--depth-scale", " ").endswith("with --depth-scale 0.001, or convert to meters")
+    assert str(integers).endswith("probably millimetres (scale 0.001); check depth_scale")
+    assert integers.advice("--depth-scale", " ").endswith("; check --depth-scale")
+    assert str(integers).startswith(f"{tmp_path / 'mm.png'}: median depth 700 m") and isinstance(integers, UnitWarning)
 
 
 @pytest.mark.parametrize(

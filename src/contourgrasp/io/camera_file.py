@@ -43,7 +43,7 @@ import numpy as np
 
 from .. import tolerances as tol
 from .. import validation
-from ..errors import InputError, UnitWarning
+from ..errors import DepthUnitWarning, InputError
 from ..perception import Intrinsics
 from ..tolerances import HOMOGENEOUS_ROW, ROTATION_TOLERANCE
 
@@ -117,8 +117,8 @@ def read_depth(path, *, depth_scale: float = DEPTH_SCALE) -> np.ndarray:
 
     Warns
     -----
-    UnitWarning
-        When the median reading is implausible in meters (e.g. millimetres).
+    DepthUnitWarning
+        When the median reading is implausible in meters (e.g. millimetres); a :class:`UnitWarning`.
     """
     path = Path(path)
     if isinstance(depth_scale, bool) or not isinstance(depth_scale, (int, float)) or not 0 < depth_scale < math.inf:
@@ -146,7 +146,6 @@ MILLIMETRE, TENTH_MILLIMETRE = 0.001, 0.0001
 
 
 def _check_depth_unit(path, median, scaled):
-    hint = "check depth_scale" if scaled else "pass integer millimetres with depth_scale=0.001, or convert to meters"
     if median > tol.MAX_PLAUSIBLE_DEPTH:
         if median * MILLIMETRE <= tol.MAX_PLAUSIBLE_DEPTH:
             unit = "probably millimetres (scale 0.001)"
@@ -154,12 +153,12 @@ def _check_depth_unit(path, median, scaled):
             unit = "probably tenths of millimetres (scale 0.0001)"
         else:  # 1e300 from a corrupt file: naming a scale would send the user looking for the wrong fix
             unit = "no depth camera's unit makes that a distance it measures"
-        message = f"median depth {median:.4g} m: {unit}; {hint}"
+        diagnosis = f"median depth {median:.4g} m: {unit}"
     elif median < tol.MIN_PLAUSIBLE_DEPTH:
-        message = f"median depth {median:.4g} m is closer than a depth camera measures: already scaled twice? {hint}"
+        diagnosis = f"median depth {median:.4g} m is closer than a depth camera measures (already scaled twice?)"
     else:
         return
-    warnings.warn(f"{path}: {message}", UnitWarning, stacklevel=3)
+    warnings.warn(DepthUnitWarning(path, diagnosis, scaled), stacklevel=3)
 
 
 def read_intrinsics(path) -> Intrinsics:
