@@ -9,7 +9,8 @@ import pytest
 import contourgrasp as cg
 from contourgrasp import InputError, NoFeasibleGrasp
 from contourgrasp.hand import Finger, Hand, Ray
-from contourgrasp.synthesis import Safeguards, fingers_clear
+from contourgrasp.synthesis import Safeguards, fingers_clear, grasp_imbalance
+from contourgrasp.synthesis._cost_kernels import contact_imbalance
 
 FAST = {"yaw_step": math.radians(10), "xy_step": 0.02}
 
@@ -222,6 +223,23 @@ def test_two_opposed_fingers_balance_a_disc():
                          Finger("b", start=(0.06, 0.0), trajectory=Ray((-1.0, 0.0)), travel=0.1)), min_touching=2)
     plan = cg.synthesize(circle(0.03), pair, max_imbalance=1e-6, **FAST)
     assert plan.quality.imbalance == pytest.approx(0.0, abs=1e-6)
+
+
+def test_the_screens_compiled_balance_is_the_squeezes_on_a_disc_and_equals_it_on_any_contour():
+    radius = 0.04
+    disc = cg.efd.fit(circle(radius), harmonics=1)
+    at = np.radians([[180, -60, -20, 20, 60], [0, 180, 0, 0, 0], [90, 0, 0, 0, 0], [0, 0, 0, 0, 0]])
+    t = np.mod(at, 2 * np.pi) * disc.T / (2 * np.pi) + 0.0  # the fit starts at angle 0, counter-clockwise
+    touching = np.array([[1, 1, 1, 1, 1], [1, 1, 0, 0, 0], [1, 0, 0, 0, 0], [0, 0, 0, 0, 0]], bool)
+    share = contact_imbalance(disc.coefficients, disc.T, t, touching, 1e-12)
+    # the thumb against four fingers over 120 deg (quality.imbalance's example), an opposed pair, one finger, none
+    assert share == pytest.approx([0.376, 0.0, 1.0, 1.0], abs=1e-3)
+    theta = np.linspace(0, 2 * np.pi, 400, endpoint=False)
+    blob = cg.efd.fit(np.c_[(0.05 + 0.01 * np.cos(3 * theta)) * np.cos(theta), 0.03 * np.sin(theta)], harmonics=12)
+    rng = np.random.default_rng(0)
+    t, touching = rng.uniform(0, blob.T, (500, 5)), rng.random((500, 5)) < 0.7
+    assert contact_imbalance(blob.coefficients, blob.T, t, touching, 1e-12) == pytest.approx(
+        grasp_imbalance(blob, t, touching), abs=1e-12)
 
 
 @pytest.mark.parametrize("option", [{"clearance": -0.01}, {"friction": float("nan")}, {"quality_gain": -1.0},

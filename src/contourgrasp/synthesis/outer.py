@@ -33,6 +33,7 @@ from .. import validation as check
 from ..contour import EFD, CurvatureMode
 from ..errors import HandError, NoFeasibleGrasp, PlannerError
 from ..hand import Hand, to_image
+from ._cost_kernels import contact_imbalance
 from ._derived import hand_arrays
 from .cost import distance
 from .descent import (Descent, DescentCheck, blocked_by_obstacles, body_names, check_candidates, descent_feasible,
@@ -426,10 +427,12 @@ def _screened_share(model, screen: PoseEvaluation, share: np.ndarray, poses: np.
 
     ``share`` (one per screened pose, NaN where not yet known) is filled in where missing: one
     screen serves every attempt of a search, each on a subset of its poses, so each pose's share
-    is computed once.
+    is computed once, by the compiled :func:`~contourgrasp.synthesis._cost_kernels.contact_imbalance`
+    (:func:`~contourgrasp.synthesis.grasp_imbalance` to rounding).
     """
     missing = poses[np.isnan(share[poses])]
-    share[missing] = grasp_imbalance(model, screen.t[missing], screen.touching[missing])
+    share[missing] = contact_imbalance(model.coefficients, model.T, screen.t[missing], screen.touching[missing],
+                                       tol.MIN_NORMAL)
     return share[poses]
 
 
