@@ -316,8 +316,11 @@ def test_hand_from_model_writes_a_hand_that_plans(tmp_path, capsys, model):
     assert json.loads((tmp_path / "plan.json").read_text())["hand"] == model
     brushing = "tips_brush_table = true" in hand.read_text()
     assert brushing == (model == "inspire")  # the bundled models' own, chosen on the bench
-    code, _, err = run(capsys, "hand-from-model", model, "--out", hand, "--no-tips-brush-table")
+    assert ("grasp_height_fraction = 0.0" in hand.read_text()) == (model == "inspire")
+    code, _, err = run(capsys, "hand-from-model", model, "--out", hand, "--no-tips-brush-table",
+                       "--grasp-height-fraction", "0.3")
     assert code == 0 and "tips_brush_table = false" in hand.read_text(), err
+    assert "grasp_height_fraction = 0.3" in hand.read_text()
 
 
 def test_hand_from_model_bad_input_is_one_line_and_writes_nothing(tmp_path, capsys):
@@ -332,6 +335,8 @@ def test_hand_from_model_bad_input_is_one_line_and_writes_nothing(tmp_path, caps
         ([model, "--fingertips", "left_tip", "right_tip", "--palm", "plate"], "palm 'plate' is not a body (a geom)"),
         ([broken, "--fingertips", "tip"], "broken.xml: cannot load the MuJoCo model"),
         ([tmp_path / "missing.xml", "--fingertips", "tip"], "no such model file"),
+        ([model, "--fingertips", "left_tip", "right_tip", "--grasp-height-fraction", "0.9"],
+         "grasp_height_fraction must be at most 0.7"),
     ]
     for argv, message in cases:
         code, _, err = run(capsys, "hand-from-model", *argv, "--out", out)

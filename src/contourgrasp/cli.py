@@ -305,6 +305,9 @@ def _add_hand_from_model_parser(sub) -> None:
                         help="plan the open fingertips just above the table, a finger swinging lower as it closes "
                              "brushing it (default: the bundled model's, else not); chosen on the bench, as the "
                              "balance is")
+    derive.add_argument("--grasp-height-fraction", type=_non_negative_float, metavar="F",
+                        help="the least planned grasp height as a fraction of the object's height, 0..0.7 (default: "
+                             "the bundled model's, else 0.4); chosen on the bench, as the balance is")
     derive.add_argument("--out", required=True, help="the hand TOML to write")
 
 
@@ -590,7 +593,8 @@ def _hand_from_model(args) -> int:
 
     derivation = derive_hand(args.model, fingertips=args.fingertips, actuators=args.actuators, palm=args.palm,
                              approach=args.approach, max_imbalance=args.max_imbalance,
-                             tips_brush_table=args.tips_brush_table)
+                             tips_brush_table=args.tips_brush_table,
+                             grasp_height_fraction=args.grasp_height_fraction)
     print("\n".join(fit_table(derivation)))
     comment = "\n".join([f"Derived by `contourgrasp hand-from-model` from {Path(args.model).name}: fit errors (mm)",
                           *(f"  {fit.name}: {fit.kind} {1000 * fit.error:.2f}" for fit in derivation.fits),

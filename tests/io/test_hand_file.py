@@ -1,3 +1,4 @@
+import dataclasses
 import math
 import re
 
@@ -56,6 +57,8 @@ def test_a_hand_file_plans_grasps(tmp_path):
         (("[[fingers]]", "[[fingers", 1), "not valid TOML"),
         (("min_touching = 2", "min_touching = 2\ntips_brush_table = 1", 1),
          r"tips_brush_table: Input should be a valid boolean"),
+        (("min_touching = 2", "min_touching = 2\ngrasp_height_fraction = 0.9", 1),
+         r"grasp_height_fraction: Input should be less than or equal to 0.7"),
     ],
 )
 def test_hand_file_errors_name_the_file_and_the_field(tmp_path, edit, message):
@@ -92,8 +95,12 @@ def test_presets_have_the_table_values():
 def test_hand_to_toml_round_trips(name):
     hand = load_hand(name)
     again = parse_hand(hand_to_toml(hand, comment="a\nb"))
-    assert (again.name, again.min_touching, again.miss_penalty, again.max_imbalance, again.tips_brush_table) == (
-        hand.name, hand.min_touching, hand.miss_penalty, hand.max_imbalance, hand.tips_brush_table)
+    assert (again.name, again.min_touching, again.miss_penalty, again.max_imbalance, again.tips_brush_table,
+            again.grasp_height_fraction) == (hand.name, hand.min_touching, hand.miss_penalty, hand.max_imbalance,
+                                             hand.tips_brush_table, hand.grasp_height_fraction)
+    assert "grasp_height_fraction" not in hand_to_toml(hand)  # the default: the presets' files as they were
+    lower = parse_hand(hand_to_toml(dataclasses.replace(hand, grasp_height_fraction=0.0)))
+    assert lower.grasp_height_fraction == 0.0
     for f, g in zip(hand.fingers, again.fingers, strict=True):
         assert (g.name, g.start, g.travel, g.virtual_start, g.alpha, g.beta, g.required) == (
             f.name, f.start, f.travel, f.virtual_start, f.alpha, f.beta, f.required)

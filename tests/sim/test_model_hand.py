@@ -146,6 +146,7 @@ def test_a_derived_hand_carries_the_models_squeeze_balance_and_table_brushing(sl
     jaco, inspire = derive_hand("jaco-three-finger").hand, derive_hand("inspire").hand
     assert (jaco.max_imbalance, jaco.tips_brush_table) == (1.0, False)
     assert (inspire.max_imbalance, inspire.tips_brush_table) == (tol.HAND_MAX_IMBALANCE, True)
+    assert (inspire.grasp_height_fraction, jaco.grasp_height_fraction) == (0.0, tol.GRASP_HEIGHT_FRACTION)
     assert not derive_hand(sliders, fingertips=["left_tip", "right_tip"]).hand.tips_brush_table
     mine = derive_hand(sliders, fingertips=["left_tip", "right_tip"], max_imbalance=0.5, tips_brush_table=True).hand
     assert (mine.max_imbalance, mine.tips_brush_table) == (0.5, True)

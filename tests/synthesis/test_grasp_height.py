@@ -45,6 +45,16 @@ def test_auto_asks_a_fraction_of_the_height_and_accepts_up_to_a_larger_one(hand)
         assert high == pytest.approx(tol.MAX_GRASP_HEIGHT_FRACTION * 0.10)
 
 
+def test_the_hands_own_fraction_is_the_one_asked_for(hand):
+    top = 0.10
+    for fraction in (0.2, 0.6):
+        low, high = grasp_height(replace(hand, grasp_height_fraction=fraction), with_top(top), "auto")
+        assert (low, high) == pytest.approx((fraction * top, tol.MAX_GRASP_HEIGHT_FRACTION * top))
+    # none: the open tips' floor, as low as the table lets a brushing hand go
+    floor = max(c.radius for c in hand.chains) + tol.GRASP_TIP_CLEARANCE
+    assert grasp_height(replace(hand, grasp_height_fraction=0.0), with_top(top), "auto")[0] == pytest.approx(floor)
+
+
 def test_tips_brushing_the_table_are_asked_just_above_it_and_may_rise_to_clear_it(hand):
     assert hand.tips_brush_table
     swing = hand.closing_tip_depth - hand.open_tip_depth

@@ -72,6 +72,14 @@ class Hand:
         default), high enough that no closing fingertip reaches it. Whether a hand grasps low
         objects better brushing the table depends on how its fingers give way and curl on them,
         which no trajectory shows, so it is chosen on the bench, as ``max_imbalance`` is.
+    grasp_height_fraction : float
+        For a 3-D hand, the least grasp height the planner asks for (rule ``"auto"``), as a fraction
+        of the object's height, in [0, ``tolerances.MAX_GRASP_HEIGHT_FRACTION``]; default
+        ``tolerances.GRASP_HEIGHT_FRACTION`` (0.4). The open tips' height is not where they meet
+        the object: a finger that curls lifts its tip toward the palm as it closes (the Inspire's by
+        50-65 mm), and from lower down it wraps more of the object's underside. Which height holds
+        best depends on how its fingers curl around objects, which no trajectory shows: chosen on the
+        bench, as ``max_imbalance`` is.
     chains : tuple of FingerChain or SampledChain, optional
         The fingers' bodies, one per finger in the order of ``fingers``; None (the default) for a
         2-D hand. Given together with ``palm``.
@@ -82,7 +90,7 @@ class Hand:
     HandError
         No fingers or more than ``tolerances.MAX_FINGERS``, a finger that is not a :class:`Finger`, names not unique, ``min_touching``
         not in 1..number of fingers, ``miss_penalty`` not in [0, ``tolerances.MAX_GAIN``], ``max_imbalance``
-        not in [0, 1] or ``tips_brush_table`` not a bool;
+        not in [0, 1], ``tips_brush_table`` not a bool or ``grasp_height_fraction`` out of range;
         chains without a palm or the reverse, not one chain per finger, or a chain that does not
         realise its finger's trajectory (:func:`check_chain`, naming the finger).
     """
@@ -93,6 +101,7 @@ class Hand:
     miss_penalty: float = 250.0
     max_imbalance: float = tol.HAND_MAX_IMBALANCE
     tips_brush_table: bool = False
+    grasp_height_fraction: float = tol.GRASP_HEIGHT_FRACTION
     description: str = field(default="", compare=False)
     chains: tuple[FingerChain | SampledChain, ...] | None = None
     palm: Palm | None = None
@@ -117,6 +126,9 @@ class Hand:
             raise HandError(f"hand {self.name!r}: tips_brush_table must be true or false, "
                             f"got {self.tips_brush_table!r}")
         object.__setattr__(self, "tips_brush_table", bool(self.tips_brush_table))
+        fraction = check.bounded(f"hand {self.name!r}: grasp_height_fraction", self.grasp_height_fraction,
+                                 tol.MAX_GRASP_HEIGHT_FRACTION, "", error=HandError)
+        object.__setattr__(self, "grasp_height_fraction", fraction)
         if len({f.name for f in self.fingers}) != n:
             raise HandError(f"hand {self.name!r}: finger names must be unique")
         self._check_body()

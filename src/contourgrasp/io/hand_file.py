@@ -15,6 +15,8 @@ Schema (all lengths in meters, angles in radians)::
                                      # asks for the open fingertips just above the table, a
                                      # finger swinging lower as it closes may brush it;
                                      # default false: no closing fingertip reaches it
+    grasp_height_fraction = 0.4      # optional, 3-D hands, 0..0.7: the least grasp height ("auto")
+                                     # as a fraction of the object's height; default 0.4
 
     [[fingers]]                      # one table per finger, at least one
     name = "thumb"
@@ -169,6 +171,8 @@ class _HandSchema(_Strict):
     miss_penalty: Gain | None = None
     max_imbalance: Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] = tol.HAND_MAX_IMBALANCE
     tips_brush_table: bool = False
+    grasp_height_fraction: Annotated[float, Field(ge=0, le=tol.MAX_GRASP_HEIGHT_FRACTION,
+                                                  allow_inf_nan=False)] = tol.GRASP_HEIGHT_FRACTION
     fingers: list[_FingerSchema] = Field(min_length=1, max_length=tol.MAX_FINGERS)
     palm: _PalmSchema | None = None
 
@@ -231,6 +235,7 @@ def parse_hand(text: str, *, source: str = "<string>") -> Hand:
             miss_penalty=_miss_penalty(schema),
             max_imbalance=schema.max_imbalance,
             tips_brush_table=schema.tips_brush_table,
+            grasp_height_fraction=schema.grasp_height_fraction,
             description=schema.description,
             chains=chains,
             palm=palm,
@@ -311,6 +316,8 @@ def hand_to_toml(hand: Hand, *, comment: str = "") -> str:
               f"min_touching = {hand.min_touching}", f"miss_penalty = {_float(hand.miss_penalty)}",
               f"max_imbalance = {_float(hand.max_imbalance)}",
               f"tips_brush_table = {'true' if hand.tips_brush_table else 'false'}"]
+    if hand.grasp_height_fraction != tol.GRASP_HEIGHT_FRACTION:  # the default's files stay as they were
+        lines.append(f"grasp_height_fraction = {_float(hand.grasp_height_fraction)}")
     for f in hand.fingers:
         lines += ["", "[[fingers]]", f"name = {_string(f.name)}", f"start = {_floats(f.start)}"]
         if isinstance(f.trajectory, Ray):

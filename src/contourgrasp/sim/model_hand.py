@@ -129,6 +129,8 @@ class ModelSpec:
         how unbalanced a squeeze its drive holds, so it is chosen on the bench, not derived.
     tips_brush_table : bool
         The derived hand's :attr:`Hand.tips_brush_table`, chosen on the bench for the same reason.
+    grasp_height_fraction : float
+        The derived hand's :attr:`Hand.grasp_height_fraction`, chosen on the bench for the same reason.
     """
 
     path: str
@@ -140,6 +142,7 @@ class ModelSpec:
     approach: str | None = None
     max_imbalance: float = tol.HAND_MAX_IMBALANCE
     tips_brush_table: bool = False
+    grasp_height_fraction: float = tol.GRASP_HEIGHT_FRACTION
 
 
 def _bundled(folder: str, xml: str, fingers, **options) -> ModelSpec:
@@ -154,21 +157,23 @@ _INSPIRE_FINGERS = ("thumb", "index", "middle", "ring", "pinky")
 #: :data:`LEVEL` (chosen on ycb-train and the thesis's five: README, "The bench on the models"). The Jaco's
 #: fingers each hold their own position: its squeeze's balance is off (max_imbalance 1), chosen on its ycb-train
 #: and thesis's-five trials (benchmarks/balance_sweep.md). The Inspire's fingertips brush the table
-#: (tips_brush_table), the Jaco's do not: chosen on the same trials (README, "The 3-D hand in the plan").
+#: (tips_brush_table), the Jaco's do not: chosen on the same trials (README, "The 3-D hand in the plan"). The
+#: Inspire's curling fingers are asked for no part of the object's height (grasp_height_fraction 0): chosen on its
+#: ycb-train trials (README, "The bench on the models").
 MODELS = {
     "inspire": _bundled(
         "inspire", "inspire_right_hand.xml", _INSPIRE_FINGERS, palm="r_palm",
         names=("thumb", "index", "middle", "ring", "little"),
         actuators=tuple(f"{f}_{j}_drive" for f in _INSPIRE_FINGERS[1:] for j in ("proximal", "distal"))
         + ("thumb_proximal_2_drive", "thumb_middle_drive", "thumb_distal_drive"),
-        hold=(("thumb_proximal_1_drive", 1.0),), approach=LEVEL, tips_brush_table=True),
+        hold=(("thumb_proximal_1_drive", 1.0),), approach=LEVEL, tips_brush_table=True, grasp_height_fraction=0.0),
     "jaco-three-finger": _bundled("jaco_three_finger", "jaco_three_finger_gripper.xml", ("thumb", "index", "pinky"),
                                   palm="right_gripper", names=("thumb", "index", "pinky"), max_imbalance=1.0),
 }
 
 
 def model_spec(model, *, fingertips=None, actuators=None, palm=None, approach=None,
-               max_imbalance=None, tips_brush_table=None) -> ModelSpec:
+               max_imbalance=None, tips_brush_table=None, grasp_height_fraction=None) -> ModelSpec:
     """A :class:`ModelSpec` from a bundled model's name (:data:`MODELS`) or an MJCF path; options override.
 
     Raises
@@ -195,6 +200,8 @@ def model_spec(model, *, fingertips=None, actuators=None, palm=None, approach=No
         spec = replace(spec, max_imbalance=max_imbalance)
     if tips_brush_table is not None:
         spec = replace(spec, tips_brush_table=tips_brush_table)
+    if grasp_height_fraction is not None:
+        spec = replace(spec, grasp_height_fraction=grasp_height_fraction)
     return replace(spec, palm=palm) if palm is not None else spec
 
 
@@ -288,7 +295,7 @@ class ClosedModel:
 
 
 def derive_hand(model, *, fingertips=None, actuators=None, palm=None, approach=None, max_imbalance=None,
-                tips_brush_table=None, name: str | None = None, close_time: float = 1.0,
+                tips_brush_table=None, grasp_height_fraction=None, name: str | None = None, close_time: float = 1.0,
                 hold_time: float = 0.5) -> Derivation:
     """Close a MuJoCo hand model with one synergy and fit its hand file (module docstring).
 
@@ -296,7 +303,7 @@ def derive_hand(model, *, fingertips=None, actuators=None, palm=None, approach=N
     ----------
     model : str, Path or ModelSpec
         A bundled model's name (:data:`MODELS`) or an MJCF file.
-    fingertips, actuators, palm, approach, max_imbalance, tips_brush_table
+    fingertips, actuators, palm, approach, max_imbalance, tips_brush_table, grasp_height_fraction
         Override the :class:`ModelSpec`'s (fingertips are required for a file).
     name : str, optional
         The hand's name; default the model file's stem.
@@ -319,7 +326,8 @@ def derive_hand(model, *, fingertips=None, actuators=None, palm=None, approach=N
         The model is unstable while closing.
     """
     spec = model_spec(model, fingertips=fingertips, actuators=actuators, palm=palm, approach=approach,
-                      max_imbalance=max_imbalance, tips_brush_table=tips_brush_table)
+                      max_imbalance=max_imbalance, tips_brush_table=tips_brush_table,
+                      grasp_height_fraction=grasp_height_fraction)
     closed = close_model(spec, close_time=close_time, hold_time=hold_time)
     fingers, fits, ends = [], [], []
     for i, finger_name in enumerate(closed.names):
@@ -331,6 +339,7 @@ def derive_hand(model, *, fingertips=None, actuators=None, palm=None, approach=N
     default_name = str(model) if isinstance(model, str) and model in MODELS else Path(spec.path).stem
     hand = Hand(name=name or default_name, fingers=tuple(fingers), min_touching=_min_touching(len(fingers)),
                 miss_penalty=MISS_PENALTY, max_imbalance=spec.max_imbalance, tips_brush_table=spec.tips_brush_table,
+                grasp_height_fraction=spec.grasp_height_fraction,
                 description=f"derived from {Path(spec.path).name} by hand-from-model")
     hand = _with_virtual_starts(hand, closed)
     hand, notes = _with_chains(hand, closed, ends)

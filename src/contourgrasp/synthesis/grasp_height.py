@@ -18,10 +18,13 @@ a pose whose open hand cannot descend that low stops as high as its bodies need,
     underside itself above the object, pose by pose (chosen on the training objects with the Inspire
     model: README, "The bench on the models").
 ``"auto"``
-    The same height asked for, at least ``tolerances.GRASP_HEIGHT_FRACTION`` of the object's
-    height, raised where the bodies need it up to ``tolerances.MAX_GRASP_HEIGHT_FRACTION`` of it:
-    the tips still close on its lower part, below its widest part for most objects lying or
-    standing on a table. Chosen on the ``ycb-train`` objects (README, "3-D hand"). A hand whose
+    The same height asked for, at least the hand's :attr:`Hand.grasp_height_fraction` of the
+    object's height (``tolerances.GRASP_HEIGHT_FRACTION``, 0.4, unless its file says), raised where
+    the bodies need it up to ``tolerances.MAX_GRASP_HEIGHT_FRACTION`` of it: the tips still close on
+    its lower part, below its widest part for most objects lying or standing on a table. Chosen on
+    the ``ycb-train`` objects (README, "3-D hand"); the Inspire model's fingers, curling, lift their
+    tips toward the palm as they close, and its fraction is 0 (the tips as low as the rest of this
+    rule lets them), chosen on its training trials (README, "The bench on the models"). A hand whose
     fingertips brush the table (:attr:`Hand.tips_brush_table`) is asked for its open tips just
     above the table, its radius plus ``tolerances.GRASP_TIP_CLEARANCE``, without the swing of a
     leaning finger that dips lower as it closes; it may still be raised to the height where no
@@ -92,5 +95,5 @@ def grasp_height(hand: Hand, heights: HeightMap, rule: str | float = "auto") -> 
     if rule == "clearance":
         return height, height
     lowest = max(open_floor, palm_floor) if hand.tips_brush_table else height
-    asked = max(lowest, tol.GRASP_HEIGHT_FRACTION * top)
+    asked = max(lowest, hand.grasp_height_fraction * top)
     return asked, max(height, asked, tol.MAX_GRASP_HEIGHT_FRACTION * top)
