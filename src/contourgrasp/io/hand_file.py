@@ -316,7 +316,7 @@ def hand_to_toml(hand: Hand, *, comment: str = "") -> str:
               f"min_touching = {hand.min_touching}", f"miss_penalty = {_float(hand.miss_penalty)}",
               f"max_imbalance = {_float(hand.max_imbalance)}",
               f"tips_brush_table = {'true' if hand.tips_brush_table else 'false'}"]
-    if hand.grasp_height_fraction != tol.GRASP_HEIGHT_FRACTION:  # the default's files stay as they were
+    if hand.grasp_height_fraction != tol.GRASP_HEIGHT_FRACTION:  # written where it differs: absent reads as the default
         lines.append(f"grasp_height_fraction = {_float(hand.grasp_height_fraction)}")
     for f in hand.fingers:
         lines += ["", "[[fingers]]", f"name = {_string(f.name)}", f"start = {_floats(f.start)}"]
