@@ -180,6 +180,8 @@ def model_spec(model, *, fingertips=None, actuators=None, palm=None, approach=No
     ------
     HandFileError
         A path without fingertips.
+    HandError
+        A ``max_imbalance`` or ``grasp_height_fraction`` out of range.
     """
     if isinstance(model, ModelSpec):
         spec = model
@@ -196,12 +198,13 @@ def model_spec(model, *, fingertips=None, actuators=None, palm=None, approach=No
         spec = replace(spec, actuators=tuple(actuators))
     if approach is not None:
         spec = replace(spec, approach=None if approach == ALONG_FINGERS else approach)
-    if max_imbalance is not None:
-        spec = replace(spec, max_imbalance=max_imbalance)
+    if max_imbalance is not None:  # checked here, before the model is closed for seconds; the Hand checks again
+        spec = replace(spec, max_imbalance=validation.bounded("max_imbalance", max_imbalance, 1.0, error=HandError))
     if tips_brush_table is not None:
         spec = replace(spec, tips_brush_table=tips_brush_table)
     if grasp_height_fraction is not None:
-        spec = replace(spec, grasp_height_fraction=grasp_height_fraction)
+        spec = replace(spec, grasp_height_fraction=validation.bounded(
+            "grasp_height_fraction", grasp_height_fraction, tol.MAX_GRASP_HEIGHT_FRACTION, error=HandError))
     return replace(spec, palm=palm) if palm is not None else spec
 
 
