@@ -97,8 +97,6 @@ def score_poses(poses, n_yaw, touching, point, curvature, inside, starts, virtua
     return distance, start_distance, outside, reaches, far_enough, cost_curvature, cost_ratio, cost_miss
 
 
-
-
 @njit(cache=True)
 def contact_imbalance(coefficients, period, t, touching, min_normal):
     """(p,) float: :func:`contourgrasp.quality.imbalance` of each pose's contacts on the EFD contour, fused.
