@@ -136,6 +136,10 @@ CANDIDATE_DEPTH_STEP = 0.02
 #: ... but only where one piece has another at least this fraction inside its filled outline (a bin's walls around an
 #: object touching them): an object's own steps, a block on a clamp's body, leave its pieces side by side.
 ENCLOSED_FRACTION = 0.5
+#: ... or where the region itself closes round at least this much of the support surface (m^2): a container's walls
+#: with an object that hides part of them, standing in front of the wall in the view (the bin's floor is 0.12 m^2, a
+#: mug handle's or a clamp's hole about 0.001).
+CONTAINER_FLOOR_AREA = 0.01
 
 #: A second candidate region at least this fraction of the largest's area draws a warning.
 SIMILAR_SIZE = 0.5

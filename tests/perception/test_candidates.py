@@ -363,3 +363,27 @@ def test_in_grey_the_wall_an_object_was_split_from_is_no_flat_part_of_it():
     result = plan_frame(grey, bin_with_box(), CAMERA, cg.load_hand("five-finger-linear"), target_px=(250, 230),
                         **FAST)
     assert result.segmentation.mask.sum() == 60 * 60
+
+
+def ring_with_a_post(side_px, post_depth):
+    """(above, depth): a square ring of wall 5 px thick, ``side_px`` across at 0.6 m, and a 30 px post over its top
+    side at ``post_depth``, reaching beyond it, as a tall object standing in front of a bin's far wall looks."""
+    above, depth = np.zeros((220, 220), bool), np.full((220, 220), 0.6)
+    lo, hi = 110 - side_px // 2, 110 + side_px // 2
+    above[lo:hi, lo:hi] = True
+    above[lo + 5:hi - 5, lo + 5:hi - 5] = False
+    above[lo - 10:lo + 20, 95:125], depth[lo - 10:lo + 20, 95:125] = True, post_depth
+    return above, depth
+
+
+def test_a_post_that_closes_a_bins_ring_in_front_of_its_wall_is_split_from_it():
+    from contourgrasp.perception.candidates import split_at_depth_steps
+
+    focal = (500.0, 500.0)  # the 150 x 150 px floor at 0.6 m: 0.032 m^2, a bin's
+    above, depth = ring_with_a_post(160, 0.55)
+    assert split_at_depth_steps(above, depth, 100)[0] == 1  # the post is not inside the walls' outline
+    assert split_at_depth_steps(above, depth, 100, focal=focal)[0] == 2  # but it closes the walls round a floor
+    above, depth = ring_with_a_post(160, 0.6)
+    assert split_at_depth_steps(above, depth, 100, focal=focal)[0] == 1  # no step between them: one surface
+    above, depth = ring_with_a_post(60, 0.55)  # a 50 px hole, 0.0036 m^2: a handle's, not a floor
+    assert split_at_depth_steps(above, depth, 100, focal=focal)[0] == 1

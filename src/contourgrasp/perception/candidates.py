@@ -31,7 +31,8 @@ from scipy import ndimage
 
 from .. import validation
 from ..errors import PerceptionError, SegmentationError
-from ..tolerances import CANDIDATE_DEPTH_STEP, ENCLOSED_FRACTION, MIN_AREA_PX, MIN_HEIGHT, SENSOR_RANGE, SIMILAR_SIZE
+from ..tolerances import (CANDIDATE_DEPTH_STEP, CONTAINER_FLOOR_AREA, ENCLOSED_FRACTION, MIN_AREA_PX, MIN_HEIGHT,
+                          SENSOR_RANGE, SIMILAR_SIZE)
 from ._pixels import check_pixel
 from .camera import Intrinsics, as_depth, check_intrinsics, valid_depth
 from .region import mask_contour, touching_regions
@@ -101,7 +102,8 @@ def find_candidates(
     ``min_area_px`` pixels are the candidates. An object against a bin's wall
     is one such region with the wall, so a region is also split where the depth
     steps by more than ``tolerances.CANDIDATE_DEPTH_STEP`` between raised
-    4-neighbours and one piece then encloses another (:func:`split_at_depth_steps`).
+    4-neighbours and one piece then encloses another, or the region closes round a
+    container's floor (:func:`split_at_depth_steps`).
 
     Parameters
     ----------
@@ -131,7 +133,8 @@ def find_candidates(
     min_height = validation.positive("min_height", min_height, error=PerceptionError)
     min_area_px = validation.integer("min_area_px", min_area_px, 1, error=PerceptionError)
     above, dead_band = raised_pixels(d, intrinsics, plane, min_height=min_height, depth_range=depth_range)
-    count, labels, stats, centroids = split_at_depth_steps(above, d, min_area_px)
+    count, labels, stats, centroids = split_at_depth_steps(above, d, min_area_px,
+                                                           focal=(intrinsics.fx, intrinsics.fy))
     if count == 0:
         return ()
     touching = touching_regions(labels, count, dead_band)
@@ -153,16 +156,19 @@ def find_candidates(
     return tuple(found)
 
 
-def split_at_depth_steps(above, depth, min_area_px: int):
+def split_at_depth_steps(above, depth, min_area_px: int, *, focal=None):
     """8-connected regions of ``above``, split where the depth steps by more than ``CANDIDATE_DEPTH_STEP``.
 
     The pixels on either side of such a step between two raised 4-neighbours are cut out; the rest
     falls into 8-connected pieces. A region is split only where one of its pieces of at least
-    ``min_area_px`` has another mostly (``ENCLOSED_FRACTION``) inside its filled outline: a bin's
-    walls around an object that touches them. An object's own steps -- a block standing on a
-    clamp's body, a lid on a box -- leave pieces side by side, and the region whole. In a split
-    region the cut pixels (and the smaller pieces) go to the nearest large piece; a region with no
-    such step is returned exactly as before.
+    ``min_area_px`` has another mostly (``ENCLOSED_FRACTION``) inside its filled outline -- a bin's
+    walls around an object that touches them -- or, with ``focal``, where the region closes round
+    holes of at least ``CONTAINER_FLOOR_AREA`` at its median depth: the walls and an object that
+    stands in front of one of them in the view (a tall object seen from a tilted camera hides the
+    wall behind it, so the walls' ring is closed only through it). An object's own steps -- a block
+    standing on a clamp's body, a lid on a box -- leave pieces side by side around no floor, and the
+    region whole. In a split region the cut pixels (and the smaller pieces) go to the nearest large
+    piece; a region with no such step is returned exactly as before.
 
     Parameters
     ----------
@@ -170,6 +176,8 @@ def split_at_depth_steps(above, depth, min_area_px: int):
     depth : (H, W) float
         Depth in meters (valid wherever ``above``).
     min_area_px : int
+    focal : (float, float), optional
+        The camera's (fx, fy), px: the floor a region closes round in m^2. None: the enclosure test alone.
 
     Returns
     -------
@@ -208,7 +216,7 @@ def split_at_depth_steps(above, depth, min_area_px: int):
         x, y, w, h = boxes[region, :4]
         box = np.s_[y:y + h, x:x + w]
         inside, seeds = regions[box] == region, keep[box] & (regions[box] == region)
-        if _encloses(pieces[box], seeds, stats, (x, y)):
+        if _encloses(pieces[box], seeds, stats, (x, y)) or _holds_floor(inside, depth[box], focal):
             labels = np.where(above, pieces.max() + regions, 0) if labels is None else labels  # the rest stay whole
             rows, cols = ndimage.distance_transform_edt(~seeds, return_distances=False, return_indices=True)
             labels[box][inside] = pieces[box][rows[inside], cols[inside]]
@@ -227,6 +235,15 @@ def split_at_depth_steps(above, depth, min_area_px: int):
         stats[i] = (found[1].start, found[0].start, found[1].stop - found[1].start, found[0].stop - found[0].start,
                     area[i])
     return count, compact, stats, centroids
+
+
+def _holds_floor(region, depth, focal) -> bool:
+    """Whether ``region`` (bool, on its box) closes round at least ``CONTAINER_FLOOR_AREA`` m^2 at its median depth."""
+    if focal is None:
+        return False
+    holes = int(ndimage.binary_fill_holes(np.pad(region, 1))[1:-1, 1:-1].sum() - region.sum())
+    z = float(np.median(depth[region]))
+    return holes * z * z >= CONTAINER_FLOOR_AREA * focal[0] * focal[1]
 
 
 def _encloses(pieces, seeds, stats, origin) -> bool:
