@@ -131,6 +131,11 @@ class ModelSpec:
         The derived hand's :attr:`Hand.tips_brush_table`, chosen on the bench for the same reason.
     grasp_height_fraction : float
         The derived hand's :attr:`Hand.grasp_height_fraction`, chosen on the bench for the same reason.
+
+    Raises
+    ------
+    HandError
+        A ``max_imbalance`` or ``grasp_height_fraction`` out of range.
     """
 
     path: str
@@ -143,6 +148,13 @@ class ModelSpec:
     max_imbalance: float = tol.HAND_MAX_IMBALANCE
     tips_brush_table: bool = False
     grasp_height_fraction: float = tol.GRASP_HEIGHT_FRACTION
+
+    def __post_init__(self):
+        # Checked as the Hand will check them, but before the model is closed for seconds.
+        object.__setattr__(self, "max_imbalance",
+                           validation.bounded("max_imbalance", self.max_imbalance, 1.0, error=HandError))
+        object.__setattr__(self, "grasp_height_fraction", validation.bounded(
+            "grasp_height_fraction", self.grasp_height_fraction, tol.MAX_GRASP_HEIGHT_FRACTION, error=HandError))
 
 
 def _bundled(folder: str, xml: str, fingers, **options) -> ModelSpec:
@@ -198,13 +210,12 @@ def model_spec(model, *, fingertips=None, actuators=None, palm=None, approach=No
         spec = replace(spec, actuators=tuple(actuators))
     if approach is not None:
         spec = replace(spec, approach=None if approach == ALONG_FINGERS else approach)
-    if max_imbalance is not None:  # checked here, before the model is closed for seconds; the Hand checks again
-        spec = replace(spec, max_imbalance=validation.bounded("max_imbalance", max_imbalance, 1.0, error=HandError))
+    if max_imbalance is not None:
+        spec = replace(spec, max_imbalance=max_imbalance)
     if tips_brush_table is not None:
         spec = replace(spec, tips_brush_table=tips_brush_table)
     if grasp_height_fraction is not None:
-        spec = replace(spec, grasp_height_fraction=validation.bounded(
-            "grasp_height_fraction", grasp_height_fraction, tol.MAX_GRASP_HEIGHT_FRACTION, error=HandError))
+        spec = replace(spec, grasp_height_fraction=grasp_height_fraction)
     return replace(spec, palm=palm) if palm is not None else spec
 
 
