@@ -7,7 +7,7 @@ from contourgrasp import InputError, NoFeasibleGrasp, load_hand
 from contourgrasp.sim import (FAILURE_CAUSES, Camera, ObjectSpec, Part, Workspace, build_scene, execute_grasp,
                               pose_matrix, run_trial)
 from contourgrasp.sim.planners import make_planner
-from contourgrasp.sim.trial import NO_PLAN, STRUCK, scripted_grasp
+from contourgrasp.sim.trial import MISSED, NO_PLAN, STRUCK, scripted_grasp
 
 PAPER = make_planner("paper", load_hand("five-finger-linear"))
 
@@ -34,6 +34,15 @@ def test_descending_onto_the_object_is_a_strike():
     middle_start = np.array([0.0, 0.215])  # the middle finger of five-finger-linear comes down on the can
     outcome = execute_grasp(scene, pose_matrix(*(centre - middle_start), 0.0), scene.camera.height - 0.056)
     assert outcome.cause == STRUCK and not outcome.success
+
+
+def test_closing_beside_the_object_is_a_miss():
+    scene = build_scene("can", seed=4)
+    centre = scene.camera.from_world(scene.object_com())[:2]
+    beside = centre + [0.0, 0.30]  # the whole open hand 30 cm from the can: every finger closes on air
+    outcome = execute_grasp(scene, pose_matrix(*beside, 0.0), scene.camera.height - 0.056)
+    assert outcome.cause == MISSED and not outcome.success
+    assert outcome.first_contact == () and outcome.push < 0.001
 
 
 def test_trial_with_the_paper_planner_lifts_the_can():

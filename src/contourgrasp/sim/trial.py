@@ -34,6 +34,10 @@ Failure causes (chapter 5), first that applies:
   wholly in view); the record keeps its message;
 * ``"a finger struck the object while descending"`` -- any hand-object contact
   before closing; the execution stops there, as a robot with a force sensor would;
+* ``"closed without touching the object"`` -- no finger touched the object while
+  closing (the plan's grasp points are not where the object is: on the YCB Windex
+  bottle, the fingers close under the spray head's overhang, round a neck narrower
+  than the head the top-down view shows); it was not lifted;
 * ``"object pushed away before all fingers touched"`` -- the object had moved
   more than :attr:`Execution.push_tolerance` in the plane when the last finger
   touched it (or closing ended with fingers still on air), and it was not lifted;
@@ -75,8 +79,9 @@ PUSHED = "object pushed away before all fingers touched"
 SLIPPED = "slipped during lift"
 DROPPED = "dropped"
 HIT = "hit a neighbour or the bin"
+MISSED = "closed without touching the object"
 #: Every failure cause a trial can report (HIT only in a scene of several objects).
-FAILURE_CAUSES = (NO_PLAN, STRUCK, PUSHED, SLIPPED, DROPPED, HIT)
+FAILURE_CAUSES = (NO_PLAN, STRUCK, MISSED, PUSHED, SLIPPED, DROPPED, HIT)
 #: Angle of the hand's x axis from the object's x axis in :func:`scripted_grasp`, rad.
 SCRIPTED_TILT = math.radians(20.0)
 
@@ -321,6 +326,8 @@ def execute_grasp(scene: Scene, transform, approach_depth: float, execution: Exe
     success = lift >= execution.success_lift and drift < execution.hold_tolerance
     if success:
         cause = None
+    elif lifted < execution.success_lift and not first_contact:
+        cause = MISSED
     elif lifted < execution.success_lift:
         cause = PUSHED if push > execution.push_tolerance else SLIPPED
     else:

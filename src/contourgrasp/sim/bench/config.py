@@ -14,7 +14,7 @@ from ..hand_model import build_hand
 from ..objects import THESIS_OBJECTS, ObjectSpec, object_spec
 from ..planners import BASELINES, make_planner, synthesis_planner
 from ..scene import Camera, Workspace
-from ..trial import DROPPED, FAILURE_CAUSES, HIT, NO_PLAN, PUSHED, SLIPPED, STRUCK, TrialRecord, run_trial
+from ..trial import DROPPED, FAILURE_CAUSES, HIT, MISSED, NO_PLAN, PUSHED, SLIPPED, STRUCK, TrialRecord, run_trial
 from ..ycb import OBJECT_SETS, load_object, object_names
 
 #: Success rates of Table 4.4 (real arm and qbHand, 10 trials per object).
@@ -22,7 +22,7 @@ THESIS_SUCCESS = {"can": 0.8, "case": 0.4, "bottle": 0.7, "stone1": 0.2, "stone2
 #: Column headings of Table 4.4 for the simulated objects.
 LABELS = {"can": "can", "case": "glasses case", "bottle": "bottle", "stone1": "stone 1", "stone2": "stone 2"}
 #: Short failure causes for the trial tables.
-SHORT_CAUSES = {NO_PLAN: "no plan", STRUCK: "struck", PUSHED: "pushed", SLIPPED: "slipped", DROPPED: "dropped",
+SHORT_CAUSES = {NO_PLAN: "no plan", STRUCK: "struck", MISSED: "missed", PUSHED: "pushed", SLIPPED: "slipped", DROPPED: "dropped",
                 HIT: "hit"}
 
 
