@@ -108,7 +108,7 @@ def test_a_bench_with_splits_reports_per_split_and_per_object(tmp_path):
     assert table.startswith("# contourgrasp bench: ycb-train (2 objects), ycb-test (1 objects), simulated\n")
     assert "| planner | ycb-train | ycb-test | all |" in table
     assert "| paper | 50 % (15–85) 2/4 | 50 % (9–91) 1/2 | 50 % (19–81) 3/6 |" in table
-    assert "| default | ycb-test | 0 | 0 | 2 | 0 | 0 |" in table
+    assert "| default | ycb-test | 0 | 0 | 0 | 2 | 0 | 0 |" in table  # no plan, struck, missed, pushed, ...
     rows = [line for line in table.splitlines() if line.startswith(("| can", "| glasses case", "| bottle"))]
     assert rows == ["| glasses case | ycb-train | 0 % (0–66) | 100 % (34–100) | — |",
                     "| can | ycb-train | 100 % (34–100) | 50 % (9–91) | pushed 1 |",
