@@ -49,7 +49,7 @@ Failure causes (chapter 5), first that applies:
   target was touched too: then it is a strike) or closing, or at the end of the
   hold a neighbour had risen more than :data:`~contourgrasp.tolerances.NEIGHBOUR_LIFT`
   or left the table (the bin's floor). It fails the trial whatever became of the
-  target, and comes before pushed, slipped and dropped: a collision is a failure
+  target, and comes before missed, pushed, slipped and dropped: a collision is a failure
   of the plan even when the target is held. Touching the bin's floor is not a hit
   (the fingertips close just above it, as above the table).
 
@@ -75,11 +75,11 @@ from .scene import Camera, Scene, Workspace, build_scene
 
 NO_PLAN = "no feasible plan"
 STRUCK = "a finger struck the object while descending"
+MISSED = "closed without touching the object"
 PUSHED = "object pushed away before all fingers touched"
 SLIPPED = "slipped during lift"
 DROPPED = "dropped"
 HIT = "hit a neighbour or the bin"
-MISSED = "closed without touching the object"
 #: Every failure cause a trial can report (HIT only in a scene of several objects).
 FAILURE_CAUSES = (NO_PLAN, STRUCK, MISSED, PUSHED, SLIPPED, DROPPED, HIT)
 #: Angle of the hand's x axis from the object's x axis in :func:`scripted_grasp`, rad.

@@ -22,8 +22,8 @@ THESIS_SUCCESS = {"can": 0.8, "case": 0.4, "bottle": 0.7, "stone1": 0.2, "stone2
 #: Column headings of Table 4.4 for the simulated objects.
 LABELS = {"can": "can", "case": "glasses case", "bottle": "bottle", "stone1": "stone 1", "stone2": "stone 2"}
 #: Short failure causes for the trial tables.
-SHORT_CAUSES = {NO_PLAN: "no plan", STRUCK: "struck", MISSED: "missed", PUSHED: "pushed", SLIPPED: "slipped", DROPPED: "dropped",
-                HIT: "hit"}
+SHORT_CAUSES = {NO_PLAN: "no plan", STRUCK: "struck", MISSED: "missed", PUSHED: "pushed", SLIPPED: "slipped",
+                DROPPED: "dropped", HIT: "hit"}
 
 
 @dataclass(frozen=True)
