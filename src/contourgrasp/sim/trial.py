@@ -326,12 +326,12 @@ def execute_grasp(scene: Scene, transform, approach_depth: float, execution: Exe
     success = lift >= execution.success_lift and drift < execution.hold_tolerance
     if success:
         cause = None
-    elif lifted < execution.success_lift and not first_contact:
-        cause = MISSED
-    elif lifted < execution.success_lift:
-        cause = PUSHED if push > execution.push_tolerance else SLIPPED
-    else:
+    elif lifted >= execution.success_lift:
         cause = DROPPED
+    elif not first_contact:
+        cause = MISSED
+    else:
+        cause = PUSHED if push > execution.push_tolerance else SLIPPED
     if probe.hit or scene.displaced_neighbours(rest):
         success, cause = False, HIT
     return GraspOutcome(success, cause, touching, first_contact, push, lift, drift, pose,
