@@ -3,23 +3,28 @@
 The bench asks whether a planner's one pose lifts an object. This asks whether *any* pose of a grid
 does, with the same simulated hand and the same execution (:func:`contourgrasp.sim.trial.execute_grasp`:
 descent, closing, lift, hold, the same success rule), the object's true position known and no picture
-taken. An object no pose of the grid lifts is out of reach of every planner that executes one
-top-down pose with this hand, whatever it sees; so the share of objects with a lifting pose bounds
-the bench's rate from above, up to the grid's resolution.
+taken. An object some pose lifts is within the hand's reach, and a planner that fails it misses
+its aim; an object no pose of the grid lifts is probably out of reach of every planner that executes
+one top-down pose with this hand, whatever it sees (probably: a pose that works can fall between the
+grid's points).
 
-One settled scene per object (seed 0). A single scene's placement only moves the object on the table
-and turns it about the vertical, which a top-down grasp from every yaw does not distinguish. The grid:
+One settled scene per object and seed (``--seeds``, default 0): the object alone on the table, or the
+bench's clutter or bin scene of that seed (``--scene``, ``--pool``: the set its neighbours come from,
+the object's split in the bench), where a hit of a neighbour or a wall fails the pose as it fails a
+trial. A single scene's placement only moves the object on the table and turns it about the
+vertical, which a top-down grasp from every yaw does not distinguish. The grid:
 the hand's yaw all the way round (``--yaws`` steps); the centre of the area its fingertips sweep
 (the centroid of the convex hull of their open and closed points, hand frame) on a square of
 offsets around the object's centre of mass (``--offsets`` per side, ``--step`` apart); the grasp
 height (the open hand's lowest fingertip above the table, as a planner gives it) at the lowest the
 planner allows (the largest fingertip radius plus :data:`~contourgrasp.tolerances.GRASP_TIP_CLEARANCE`)
-and at the ``--heights`` fractions of the object's height that lie above that. The scene's MuJoCo state is restored before each pose.
+and at the ``--heights`` fractions of the object's height that lie above that. The scene's MuJoCo
+state is restored before each pose.
 
 Usage::
 
     .venv/bin/python benchmarks/pose_oracle.py --objects ycb-train [--hand five-finger-linear | --hand-model inspire]
-        [--workers 2] [--json FILE]
+        [--scene clutter|bin --pool ycb-train --seeds 0,1,2] [--workers 2] [--json FILE]
 
 Prints a markdown table, a row per object as it is done: poses, lifted poses, the grasp heights that
 lifted, the failures by cause, and the seconds since the start.
@@ -35,6 +40,7 @@ import multiprocessing
 import time
 import warnings
 from pathlib import Path
+from typing import NamedTuple
 
 import cv2
 import mujoco
@@ -45,6 +51,7 @@ from contourgrasp.io.hand_file import load_hand
 from contourgrasp.sim import trial
 from contourgrasp.sim.bench.config import SHORT_CAUSES
 from contourgrasp.sim.model_mount import mount_model
+from contourgrasp.sim.clutter import build_clutter
 from contourgrasp.sim.scene import build_scene
 from contourgrasp.sim.ycb import load_object, object_names
 
@@ -59,10 +66,28 @@ def _hand(hand: str, hand_model: str | None):
     return mounted, mounted.hand
 
 
+class Task(NamedTuple):
+    """One yaw of the grid on one scene."""
+
+    name: str
+    seed: int
+    scene_kind: str
+    pool: tuple[str, ...]
+    hand: str
+    hand_model: str | None
+    yaw: float
+    offsets: tuple[tuple[float, float], ...]
+    fractions: tuple[float, ...]
+
+
 @functools.lru_cache(maxsize=1)
-def _scene(name: str, hand: str, hand_model: str | None):
+def _scene(name: str, seed: int, scene_kind: str, pool: tuple[str, ...], hand: str, hand_model: str | None):
     simulated, _ = _hand(hand, hand_model)
-    scene = build_scene(load_object(name), seed=0, hand=simulated)
+    if scene_kind == "single":
+        scene = build_scene(load_object(name), seed=seed, hand=simulated)
+    else:
+        scene = build_clutter(load_object(name), [load_object(n) for n in pool], kind=scene_kind, seed=seed,
+                              hand=simulated)
     state = np.empty(mujoco.mj_stateSize(scene.model, STATE))
     mujoco.mj_getState(scene.model, scene.data, state, STATE)
     return scene, state
@@ -81,12 +106,12 @@ def swept_centre(planned_hand) -> np.ndarray:
     return np.array([moments["m10"], moments["m01"]]) / moments["m00"]
 
 
-def run_yaw(task) -> tuple[float, list[dict]]:
+def run_yaw(task: Task) -> tuple[float, list[dict]]:
     """Every offset and height of the grid at one yaw of the hand: the object's height (m) and each pose's outcome."""
-    name, hand, hand_model, yaw, offsets, fractions = task
     warnings.simplefilter("ignore")
-    scene, state = _scene(name, hand, hand_model)
-    _, planned = _hand(hand, hand_model)
+    scene, state = _scene(task.name, task.seed, task.scene_kind, task.pool, task.hand, task.hand_model)
+    _, planned = _hand(task.hand, task.hand_model)
+    yaw = task.yaw
     model, data = scene.model, scene.data
     top = float(scene.object_points()[:, 2].max())
     centre = scene.camera.from_world(scene.object_com()[None])[0][:2]
@@ -94,7 +119,7 @@ def run_yaw(task) -> tuple[float, list[dict]]:
     c, s = math.cos(yaw), math.sin(yaw)
     turned = np.array([[c, -s], [s, c]]) @ hand_centre
     rows = []
-    for (dx, dy), height in itertools.product(offsets, heights(planned, top, fractions)):
+    for (dx, dy), height in itertools.product(task.offsets, heights(planned, top, task.fractions)):
         x, y = centre + (dx, dy) - turned
         mujoco.mj_setState(model, data, state, STATE)
         mujoco.mj_forward(model, data)
@@ -115,15 +140,25 @@ def main() -> None:
     parser.add_argument("--step", type=float, default=0.015, help="offset spacing, m")
     parser.add_argument("--heights", default="0.2,0.35,0.5,0.65",
                         help="grasp heights besides the floor, fractions of the object's height")
+    parser.add_argument("--scene", choices=("single", "clutter", "bin"), default="single")
+    parser.add_argument("--seeds", default="0", help="comma-separated scene seeds (the bench's trial t: seed t)")
+    parser.add_argument("--pool", default=None,
+                        help="with --scene clutter|bin: the object set the neighbours come from (the bench: the target's split)")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--json", default=None, help="write every pose's outcome here")
     args = parser.parse_args()
+    if args.scene != "single" and args.pool is None:
+        parser.error("--scene clutter|bin needs --pool, e.g. ycb-train")
+    if args.scene != "single" and args.hand_model is not None:
+        parser.error("the clutter and bin scenes simulate the hand files' hands, not --hand-model")
     names = object_names(args.objects)
+    seeds = [int(seed) for seed in args.seeds.split(",")]
     spokes = (np.arange(args.offsets) - (args.offsets - 1) / 2) * args.step
     offsets = [(float(dx), float(dy)) for dx in spokes for dy in spokes]
     fractions = tuple(float(f) for f in args.heights.split(","))
-    tasks = [(name, args.hand, args.hand_model, float(yaw), offsets, fractions)
-             for name in names for yaw in np.arange(args.yaws) * 2 * math.pi / args.yaws]
+    tasks = [Task(name, seed, args.scene, _pool(args.pool, name), args.hand, args.hand_model, float(yaw),
+                  tuple(offsets), fractions)
+             for name in names for seed in seeds for yaw in np.arange(args.yaws) * 2 * math.pi / args.yaws]
     print(f"hand: {args.hand_model or args.hand}; {len(offsets)} offsets, {args.yaws} yaws, up to "
           f"{len(fractions) + 1} grasp heights per object\n")
     print("| object | height, mm | poses | lifted | share | lifting grasp heights, mm | failures by cause | s |\n"
@@ -131,10 +166,11 @@ def main() -> None:
     started = time.perf_counter()
     by_object, reachable = {}, 0
     with multiprocessing.get_context("spawn").Pool(args.workers) as pool:
-        for (name, *_), (top, rows) in zip(tasks, pool.imap(run_yaw, tasks)):
-            by_object.setdefault(name, []).extend(rows)
-            if len(by_object[name]) == len(rows) * args.yaws:
-                reachable += _print_row(name, top, by_object[name], time.perf_counter() - started)
+        for task, (top, rows) in zip(tasks, pool.imap(run_yaw, tasks)):
+            key = task.name if len(seeds) == 1 and args.scene == "single" else f"{task.name} (seed {task.seed})"
+            by_object.setdefault(key, []).extend(rows)
+            if len(by_object[key]) == len(rows) * args.yaws:
+                reachable += _print_row(key, top, by_object[key], time.perf_counter() - started)
     print(f"\nobjects with a lifting pose: {reachable} of {len(by_object)}")
     if args.json:
         Path(args.json).write_text(json.dumps(by_object))
@@ -148,6 +184,15 @@ def _print_row(name: str, top: float, rows: list[dict], elapsed: float) -> bool:
           f"{100 * len(lifted) / len(rows):.1f} % | {', '.join(map(str, lifting)) or '-'} | "
           + ", ".join(f"{c} {n}" for c, n in causes.most_common()) + f" | {elapsed:.0f} |", flush=True)
     return bool(lifted)
+
+
+def _pool(pool: str | None, target: str) -> tuple[str, ...]:
+    """The neighbours' object names: the set's other members (the target itself when it is alone)."""
+    if pool is None:
+        return ()
+    others = tuple(n for n in object_names(pool) if n != target)
+    return others or (target,)
+
 
 if __name__ == "__main__":
     main()
