@@ -47,11 +47,12 @@ import mujoco
 import numpy as np
 
 from contourgrasp import tolerances
+from contourgrasp.hand import rotation
 from contourgrasp.io.hand_file import load_hand
 from contourgrasp.sim import trial
 from contourgrasp.sim.bench.config import SHORT_CAUSES
-from contourgrasp.sim.model_mount import mount_model
 from contourgrasp.sim.clutter import build_clutter
+from contourgrasp.sim.model_mount import mount_model
 from contourgrasp.sim.scene import build_scene
 from contourgrasp.sim.ycb import load_object, object_names
 
@@ -80,6 +81,15 @@ class Task(NamedTuple):
     fractions: tuple[float, ...]
 
 
+class Settled(NamedTuple):
+    """A settled scene, its MuJoCo state, and what the grid is laid out from, read in that state."""
+
+    scene: object
+    state: np.ndarray
+    top: float  # the object's top above the table (the bin's floor), m
+    centre: np.ndarray  # (2,) its centre of mass in the reference camera's frame, m
+
+
 @functools.lru_cache(maxsize=1)
 def _scene(name: str, seed: int, scene_kind: str, pool: tuple[str, ...], hand: str, hand_model: str | None):
     simulated, _ = _hand(hand, hand_model)
@@ -90,7 +100,8 @@ def _scene(name: str, seed: int, scene_kind: str, pool: tuple[str, ...], hand: s
                               hand=simulated)
     state = np.empty(mujoco.mj_stateSize(scene.model, STATE))
     mujoco.mj_getState(scene.model, scene.data, state, STATE)
-    return scene, state
+    return Settled(scene, state, float(scene.object_points()[:, 2].max()),
+                   scene.camera.from_world(scene.object_com()[None])[0][:2])
 
 
 def heights(planned_hand, object_height: float, fractions) -> list[float]:
@@ -109,15 +120,10 @@ def swept_centre(planned_hand) -> np.ndarray:
 def run_yaw(task: Task) -> tuple[float, list[dict]]:
     """Every offset and height of the grid at one yaw of the hand: the object's height (m) and each pose's outcome."""
     warnings.simplefilter("ignore")
-    scene, state = _scene(task.name, task.seed, task.scene_kind, task.pool, task.hand, task.hand_model)
+    scene, state, top, centre = _scene(task.name, task.seed, task.scene_kind, task.pool, task.hand, task.hand_model)
     _, planned = _hand(task.hand, task.hand_model)
-    yaw = task.yaw
-    model, data = scene.model, scene.data
-    top = float(scene.object_points()[:, 2].max())
-    centre = scene.camera.from_world(scene.object_com()[None])[0][:2]
-    hand_centre = swept_centre(planned)
-    c, s = math.cos(yaw), math.sin(yaw)
-    turned = np.array([[c, -s], [s, c]]) @ hand_centre
+    model, data, yaw = scene.model, scene.data, task.yaw
+    turned = rotation(yaw) @ swept_centre(planned)
     rows = []
     for (dx, dy), height in itertools.product(task.offsets, heights(planned, top, task.fractions)):
         x, y = centre + (dx, dy) - turned
