@@ -47,6 +47,7 @@ import mujoco
 import numpy as np
 
 from contourgrasp import tolerances
+from contourgrasp.errors import ContourGraspError
 from contourgrasp.hand import rotation
 from contourgrasp.io.hand_file import load_hand
 from contourgrasp.sim import trial
@@ -148,8 +149,8 @@ def main() -> None:
                         help="grasp heights besides the floor, fractions of the object's height")
     parser.add_argument("--scene", choices=("single", "clutter", "bin"), default="single")
     parser.add_argument("--seeds", default="0", help="comma-separated scene seeds (the bench's trial t: seed t)")
-    parser.add_argument("--pool", default=None,
-                        help="with --scene clutter|bin: the object set the neighbours come from (the bench: the target's split)")
+    parser.add_argument("--pool", default=None, help="with --scene clutter|bin: the object set the neighbours "
+                                                     "come from (in the bench: the target's split)")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--json", default=None, help="write every pose's outcome here")
     args = parser.parse_args()
@@ -157,12 +158,16 @@ def main() -> None:
         parser.error("--scene clutter|bin needs --pool, e.g. ycb-train")
     if args.scene != "single" and args.hand_model is not None:
         parser.error("the clutter and bin scenes simulate the hand files' hands, not --hand-model")
-    names = object_names(args.objects)
-    seeds = [int(seed) for seed in args.seeds.split(",")]
+    try:
+        names = object_names(args.objects)
+        pools = {name: _pool(args.pool, name) for name in names}
+        seeds = [int(seed) for seed in args.seeds.split(",")]
+        fractions = tuple(float(f) for f in args.heights.split(","))
+    except (ContourGraspError, ValueError) as err:
+        parser.error(str(err))
     spokes = (np.arange(args.offsets) - (args.offsets - 1) / 2) * args.step
     offsets = [(float(dx), float(dy)) for dx in spokes for dy in spokes]
-    fractions = tuple(float(f) for f in args.heights.split(","))
-    tasks = [Task(name, seed, args.scene, _pool(args.pool, name), args.hand, args.hand_model, float(yaw),
+    tasks = [Task(name, seed, args.scene, pools[name], args.hand, args.hand_model, float(yaw),
                   tuple(offsets), fractions)
              for name in names for seed in seeds for yaw in np.arange(args.yaws) * 2 * math.pi / args.yaws]
     print(f"hand: {args.hand_model or args.hand}; {len(offsets)} offsets, {args.yaws} yaws, up to "
@@ -179,7 +184,9 @@ def main() -> None:
                 reachable += _print_row(key, top, by_object[key], time.perf_counter() - started)
     print(f"\nobjects with a lifting pose: {reachable} of {len(by_object)}")
     if args.json:
-        Path(args.json).write_text(json.dumps(by_object))
+        partial = Path(f"{args.json}.partial")
+        partial.write_text(json.dumps(by_object))
+        partial.replace(args.json)
 
 
 def _print_row(name: str, top: float, rows: list[dict], elapsed: float) -> bool:
