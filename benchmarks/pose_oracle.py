@@ -17,9 +17,9 @@ the hand's yaw all the way round (``--yaws`` steps); the centre of the area its 
 (the centroid of the convex hull of their open and closed points, hand frame) on a square of
 offsets around the object's centre of mass (``--offsets`` per side, ``--step`` apart); the grasp
 height (the open hand's lowest fingertip above the table, as a planner gives it) at the lowest the
-planner allows (the largest fingertip radius plus :data:`~contourgrasp.tolerances.GRASP_TIP_CLEARANCE`)
-and at the ``--heights`` fractions of the object's height that lie above that. The scene's MuJoCo
-state is restored before each pose.
+planner allows (:func:`~contourgrasp.synthesis.grasp_height.open_floor`) and at the ``--heights``
+fractions of the object's height that lie above that. The scene's MuJoCo state is restored before
+each pose.
 
 Usage::
 
@@ -46,16 +46,14 @@ import cv2
 import mujoco
 import numpy as np
 
-from contourgrasp import tolerances
 from contourgrasp.errors import ContourGraspError
 from contourgrasp.hand import rotation
 from contourgrasp.io.hand_file import load_hand
 from contourgrasp.sim import trial
 from contourgrasp.sim.bench.config import SHORT_CAUSES
-from contourgrasp.sim.clutter import build_clutter
 from contourgrasp.sim.model_mount import mount_model
-from contourgrasp.sim.scene import build_scene
 from contourgrasp.sim.ycb import load_object, object_names
+from contourgrasp.synthesis.grasp_height import open_floor
 
 STATE = mujoco.mjtState.mjSTATE_INTEGRATION
 
@@ -94,11 +92,8 @@ class Settled(NamedTuple):
 @functools.lru_cache(maxsize=1)
 def _scene(name: str, seed: int, scene_kind: str, pool: tuple[str, ...], hand: str, hand_model: str | None):
     simulated, _ = _hand(hand, hand_model)
-    if scene_kind == "single":
-        scene = build_scene(load_object(name), seed=seed, hand=simulated)
-    else:
-        scene = build_clutter(load_object(name), [load_object(n) for n in pool], kind=scene_kind, seed=seed,
-                              hand=simulated)
+    scene = trial.trial_scene(load_object(name), seed=seed, scene_kind=scene_kind,
+                              pool=[load_object(n) for n in pool], hand=simulated)
     state = np.empty(mujoco.mj_stateSize(scene.model, STATE))
     mujoco.mj_getState(scene.model, scene.data, state, STATE)
     return Settled(scene, state, float(scene.object_points()[:, 2].max()),
@@ -107,7 +102,7 @@ def _scene(name: str, seed: int, scene_kind: str, pool: tuple[str, ...], hand: s
 
 def heights(planned_hand, object_height: float, fractions) -> list[float]:
     """The grid's grasp heights, m: the planner's floor, then the fractions of the object's height above it."""
-    floor = max(f.radius for f in planned_hand.fingers) + tolerances.GRASP_TIP_CLEARANCE
+    floor = open_floor(planned_hand)
     return [floor] + [f * object_height for f in fractions if f * object_height > floor]
 
 

@@ -232,11 +232,8 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
         The neighbours of a ``clutter`` or ``bin`` scene are drawn from it.
     """
     started = time.perf_counter()
-    options = {"hand": hand, "design": design, "timing": timing, "camera": camera, "workspace": workspace}
-    if scene_kind == "single":
-        scene = build_scene(object_spec, seed=seed, **options)
-    else:
-        scene = build_clutter(object_spec, pool, kind=scene_kind, seed=seed, **options)
+    scene = trial_scene(object_spec, seed=seed, scene_kind=scene_kind, pool=pool, hand=hand, design=design,
+                        timing=timing, camera=camera, workspace=workspace)
     rgb, depth = render(scene, noise=noise, seed=seed)
     target = {} if scene.view is None else {"target_px": target_pixel(scene)}
     planning = time.perf_counter()
@@ -261,6 +258,14 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
         observe(scene)
     return TrialRecord(object=scene.object.name, seed=seed, **fields, plan_error=plan_error, sim_time=scene.time,
                        plan_time=plan_time, wall_time=time.perf_counter() - started)
+
+
+def trial_scene(object_spec, *, seed: int, scene_kind: str = "single", pool=(), **options) -> Scene:
+    """The settled scene of a trial: :func:`~contourgrasp.sim.scene.build_scene` for ``"single"``, else
+    :func:`~contourgrasp.sim.clutter.build_clutter` (``pool``: its neighbours); ``options`` go to either."""
+    if scene_kind == "single":
+        return build_scene(object_spec, seed=seed, **options)
+    return build_clutter(object_spec, pool, kind=scene_kind, seed=seed, **options)
 
 
 def hand_pose_from_matrix(transform) -> tuple[float, float, float]:

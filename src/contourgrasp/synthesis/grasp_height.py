@@ -59,6 +59,14 @@ def check_rule(rule):
     return validation.bounded("grasp_height", rule, tol.MAX_HAND_SIZE, " m", error=PlannerError)
 
 
+def open_floor(hand: Hand) -> float:
+    """The lowest the open hand's lowest fingertip (its centre) may be above the table, m.
+
+    Its radius plus ``tolerances.GRASP_TIP_CLEARANCE``; ``hand`` is a 3-D hand.
+    """
+    return max(c.radius for c in hand.chains) + tol.GRASP_TIP_CLEARANCE
+
+
 def grasp_height(hand: Hand, heights: HeightMap, rule: str | float = "auto") -> tuple[float, float]:
     """The grasp height asked for and the highest accepted: the open hand's lowest fingertip above the table, m.
 
@@ -89,11 +97,11 @@ def grasp_height(hand: Hand, heights: HeightMap, rule: str | float = "auto") -> 
             raise NoFeasibleGrasp(f"a grasp height of {1000 * rule:.0f} mm is not below the object's top "
                                   f"({1000 * top:.0f} mm): the fingertips would close over it")
         return rule, rule
-    open_floor = max(c.radius for c in hand.chains) + tol.GRASP_TIP_CLEARANCE
+    floor = open_floor(hand)
     palm_floor = top + tol.GRASP_PALM_CLEARANCE - hand.open_tip_depth
-    height = max(open_floor + hand.closing_tip_depth - hand.open_tip_depth, palm_floor)
+    height = max(floor + hand.closing_tip_depth - hand.open_tip_depth, palm_floor)
     if rule == "clearance":
         return height, height
-    lowest = max(open_floor, palm_floor) if hand.tips_brush_table else height
+    lowest = max(floor, palm_floor) if hand.tips_brush_table else height
     asked = max(lowest, hand.grasp_height_fraction * top)
     return asked, max(height, asked, tol.MAX_GRASP_HEIGHT_FRACTION * top)
