@@ -377,7 +377,8 @@ def _perceive(rgb, depth, intrinsics, *, segment, mask, depth_mode, footprint, f
     candidates = () if support is None else support.candidates
     target, reason = None, ""
     if chosen:
-        target, reason = perception.choose_target(candidates, target_px=target_px, roi=roi)
+        pixel_heights = None if target_px is None or plane is None else perception.table.heights(d, intrinsics, plane)
+        target, reason = perception.choose_target(candidates, target_px=target_px, roi=roi, pixel_heights=pixel_heights)
     elif mask is None and segment != "rgb" and any(c.in_view for c in candidates):
         target, reason = perception.choose_target(candidates, max_width=max_width)
     if mask is not None:

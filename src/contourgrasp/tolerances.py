@@ -177,6 +177,15 @@ MIN_FLAT_HEIGHT = 0.0005
 #: mask; the whole image is searched only when the evidence reaches that window's edge.
 FLAT_WINDOW_PX = 96
 
+#: A target pixel on a low-lying part (below ``MIN_HEIGHT``, above the table's noise) is followed to the
+#: candidate it belongs to within this distance, pixels (``perception.candidates.low_part_candidate``):
+#: the YCB fork, seen from the bench's camera, is 150-170 px long, its raised pieces at either end.
+LOW_PART_REACH_PX = 128
+
+#: ... into a candidate's raised pixels that stand at most this much above ``MIN_HEIGHT`` next to it (m):
+#: a part rises into its own object; a neighbour it only touches stands up sharply beside it.
+LOW_PART_STEP = 0.01
+
 #: Largest colour-depth misregistration searched for, pixels in each direction.
 MAX_COLOUR_OFFSET_PX = 8
 

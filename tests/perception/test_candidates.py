@@ -14,7 +14,9 @@ from contourgrasp.cli import main
 from contourgrasp.errors import PerceptionError, SegmentationError
 from contourgrasp.io.camera_file import read_rgbd
 from contourgrasp.io.plan_file import image_plan_to_dict
-from contourgrasp.perception import Candidate, choose_target, find_candidates, fit_table_plane, segment
+from contourgrasp.perception import (Candidate, choose_target, find_candidates, fit_table_plane, low_part_candidate,
+                                    segment)
+from contourgrasp.perception.table import heights
 
 from perception_scenes import CAMERA, H, W
 
@@ -322,6 +324,67 @@ def test_a_pixel_on_an_object_inside_a_bins_walls_is_the_object_not_the_bin():
     assert target.bbox == (270, 180, 60, 40)
     ring, _ = choose_target(found, target_px=(155, 200))
     assert ring.bbox == (150, 100, 300, 210)
+
+
+#: A low flat object (a fork's raised neck: 18 mm) with a thin handle leaving its right side.
+NECK = (300, 200, 100, 60, 0.018)
+
+
+def with_handle(depth, handle_height=0.005, noise=0.002, seed=0):
+    """``depth`` with a thin handle (4 x 60 px, ``handle_height`` up) leaving NECK's right side, and table noise."""
+    depth = depth.copy()
+    depth[228:232, 400:460] = TABLE - handle_height
+    return depth + np.random.default_rng(seed).normal(0.0, noise, depth.shape)
+
+
+def up(depth):
+    return heights(depth, CAMERA, fit_table_plane(depth, CAMERA))
+
+
+def test_a_pixel_on_a_low_part_is_the_candidate_the_part_leads_to():
+    """A fork's handle lies below MIN_HEIGHT: no candidate holds it, and clicking it names its object."""
+    depth = with_handle(scene(NECK, B))
+    found = candidates(depth)
+    target, reason = choose_target(found, target_px=(450, 230), pixel_heights=up(depth))
+    assert target.bbox[:2] == NECK[:2] and reason == "the candidate the low part under pixel (450, 230) belongs to"
+    assert low_part_candidate(found, (330, 230), up(depth)) is None  # on the neck itself: the candidate under the pixel
+    with pytest.raises(SegmentationError, match=r"^no object at pixel \(450, 230\)"):
+        choose_target(found, target_px=(450, 230))  # without heights, as before
+    with pytest.raises(SegmentationError, match=r"^no object at pixel \(450, 260\)"):
+        choose_target(found, target_px=(450, 260), pixel_heights=up(depth))  # the bare table beside the handle
+
+
+def test_a_low_part_does_not_lead_to_a_tall_neighbour_it_touches():
+    """A 10 cm box against the handle's end stands up sharply beside it: the handle still leads to its neck, and a
+    handle that touches only the tall box leads nowhere (refused as before, rather than the wrong object)."""
+    tall = (460, 210, 40, 40, 0.10)
+    depth = with_handle(scene(NECK, tall))
+    assert choose_target(candidates(depth), target_px=(455, 230), pixel_heights=up(depth))[0].bbox[:2] == NECK[:2]
+    alone = with_handle(scene(tall))
+    assert low_part_candidate(candidates(alone), (455, 230), up(alone)) is None
+
+
+@pytest.mark.parametrize("handle_height, found_by_part", [(0.004, True), (0.0015, False)])
+def test_a_low_part_must_stand_above_the_tables_noise(handle_height, found_by_part):
+    """With 2 mm of noise, 5 sigma of the 5 x 5 median (about 1 mm) separates a 4 mm handle from the table; 1.5 mm
+    does not."""
+    depth = with_handle(scene(NECK), handle_height=handle_height)
+    assert (low_part_candidate(candidates(depth), (450, 230), up(depth)) is not None) == found_by_part
+
+
+def test_a_low_part_inside_a_bins_walls_leads_to_its_object_not_the_bin():
+    """The walls' filled ring holds the handle's pixel and the neck alike: the innermost candidate the part reaches."""
+    walls = [(150, 100, 400, 10, 0.10), (150, 350, 400, 10, 0.10), (150, 100, 10, 260, 0.10), (540, 100, 10, 260, 0.10)]
+    depth = with_handle(scene(*walls, NECK))
+    found = candidates(depth)
+    assert choose_target(found, target_px=(450, 230))[0].bbox == (150, 100, 400, 260)  # without heights: the bin
+    assert choose_target(found, target_px=(450, 230), pixel_heights=up(depth))[0].bbox[:2] == NECK[:2]
+
+
+def test_pixel_heights_of_another_size_are_refused():
+    found = candidates(scene(A))
+    with pytest.raises(PerceptionError, match=r"pixel_heights is 10x10 but the depth image is 640x480"):
+        choose_target(found, target_px=(450, 230), pixel_heights=np.zeros((10, 10)))
 
 
 def bin_with_box():

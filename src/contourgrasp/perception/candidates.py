@@ -31,8 +31,9 @@ from scipy import ndimage
 
 from .. import validation
 from ..errors import PerceptionError, SegmentationError
-from ..tolerances import (CANDIDATE_DEPTH_STEP, CONTAINER_FLOOR_AREA, ENCLOSED_FRACTION, MIN_AREA_PX, MIN_HEIGHT,
-                          SENSOR_RANGE, SIMILAR_SIZE)
+from ..tolerances import (CANDIDATE_DEPTH_STEP, CONTAINER_FLOOR_AREA, ENCLOSED_FRACTION, FLAT_HEIGHT_SIGMAS,
+                          LOW_PART_REACH_PX, LOW_PART_STEP, MIN_AREA_PX, MIN_FLAT_HEIGHT, MIN_HEIGHT, SENSOR_RANGE,
+                          SIMILAR_SIZE)
 from ._pixels import check_pixel
 from .camera import Intrinsics, as_depth, check_intrinsics, valid_depth
 from .region import mask_contour, touching_regions
@@ -287,7 +288,7 @@ def _filled(region, bbox) -> np.ndarray:
 
 
 def choose_target(candidates, *, target_px=None, roi=None, rule: str = "hand",
-                  max_width: float | None = None) -> tuple[Candidate, str]:
+                  max_width: float | None = None, pixel_heights=None) -> tuple[Candidate, str]:
     """The candidate to grasp, and why it was chosen (one line).
 
     Parameters
@@ -309,6 +310,14 @@ def choose_target(candidates, *, target_px=None, roi=None, rule: str = "hand",
     max_width : float, optional
         The ``"hand"`` rule: the widest object the hand spans, m
         (:func:`hand_opening`); None: every candidate fits.
+    pixel_heights : (H, W) float, optional
+        With ``target_px``: every pixel's height above the support plane, m
+        (:func:`~contourgrasp.perception.table.heights`; NaN where unknown). A
+        pixel that stands less than ``MIN_HEIGHT`` up but above the table's
+        noise lies on a low part of an object -- a fork's handle, a tool's flat
+        blade -- which no candidate holds: the target is the candidate that
+        part leads to (:func:`low_part_candidate`). None: the candidate under
+        the pixel only.
 
     Returns
     -------
@@ -332,7 +341,14 @@ def choose_target(candidates, *, target_px=None, roi=None, rule: str = "hand",
     rule = validation.choice("rule", rule, TARGET_RULES, error=PerceptionError)
     shape = candidates[0].mask.shape if candidates else None
     if target_px is not None:
-        return _at_pixel(candidates, check_pixel(target_px, shape), shape)
+        pixel = check_pixel(target_px, shape)
+        if pixel_heights is not None and candidates:
+            validation.same_size(np.shape(pixel_heights), shape, "pixel_heights", "the depth image",
+                                 error=PerceptionError)
+            found = low_part_candidate(candidates, pixel, pixel_heights)
+            if found is not None:
+                return found, f"the candidate the low part under pixel ({pixel[0]}, {pixel[1]}) belongs to"
+        return _at_pixel(candidates, pixel, shape)
     if roi is not None:
         return _in_roi(candidates, check_roi(roi, shape))
     if not candidates:
@@ -401,6 +417,108 @@ def _at_pixel(candidates, pixel, shape):
         raise SegmentationError("no-object", f"no object at pixel ({u}, {v}); nothing stands on the support surface")
     cu, cv = min((_nearest_pixel(c.mask, u, v) for c in candidates), key=lambda p: (p[0] - u) ** 2 + (p[1] - v) ** 2)
     raise SegmentationError("no-object", f"no object at pixel ({u}, {v}); the nearest candidate is at ({cu}, {cv})")
+
+
+def low_part_candidate(candidates, pixel, pixel_heights, *, min_height: float = MIN_HEIGHT,
+                       min_area_px: int = MIN_AREA_PX) -> Candidate | None:
+    """The candidate a low-lying part under ``pixel`` belongs to, or None when the pixel is not on one.
+
+    Thin parts lying on the table (a fork's handle, a spoon's bowl, a blade)
+    stand less than ``min_height`` up, so they are not candidates, and a user
+    who clicks on one clicks beside every candidate -- or, in a bin, inside the
+    walls' filled ring. Within ``LOW_PART_REACH_PX`` of the pixel the heights
+    are median-filtered over 5 x 5 pixels (as the grey images' flat-part
+    evidence, :mod:`~contourgrasp.perception.colour`); the pixel is on a low part
+    when it stands more than ``FLAT_HEIGHT_SIGMAS`` times the table's spread
+    there (its median absolute deviation on the window's pixels below
+    ``min_height``, scaled to a Gaussian's sigma; the low part itself is a
+    small share of them) above the table's level. The part
+    is the 8-connected region of such pixels around it that no candidate
+    stands on, and it leads to the candidates it rises into without a step:
+    their raised pixels (above ``min_height``, opened 3 x 3 and in a region of
+    at least ``min_area_px``, as :func:`find_candidates` has them; not merely
+    inside a filled outline) next to it that stand less than
+    ``LOW_PART_STEP`` higher. A fork's handle rises into its raised neck; a
+    bottle it lies against stands up sharply beside it. The target is the
+    candidate so reached nearest the pixel; of candidates nested in one
+    another, the innermost.
+
+    Parameters
+    ----------
+    candidates : sequence of Candidate
+    pixel : (int, int)
+        (u, v), inside the image.
+    pixel_heights : (H, W) float
+        Height above the support plane, m (NaN where unknown).
+    min_height, min_area_px : float, int
+        :func:`find_candidates`': the height from which a pixel stands on the surface (m), and the
+        smallest candidate (px). A raised speck smaller than that under the pixel is part of a low part.
+
+    Returns
+    -------
+    Candidate or None
+        None when the pixel stands on a candidate's raised pixels already, is not
+        above the table's noise, or its part reaches no candidate within the window.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> h = np.zeros((60, 80)); h[20:40, 10:30] = 0.015; h[28:32, 30:70] = 0.005  # a flat block, a thin handle
+    >>> block = Candidate(1, h > 0.01, np.zeros((0, 2)), 400, 0.015, (19.5, 29.5), (10, 20, 20, 20), True)
+    >>> low_part_candidate([block], (60, 30), h) is block
+    True
+    >>> low_part_candidate([block], (60, 50), h) is None  # the bare table
+    True
+    """
+    u, v = pixel
+    h = np.asarray(pixel_heights, dtype=np.float32)
+    box = np.s_[max(v - LOW_PART_REACH_PX, 0):min(v + LOW_PART_REACH_PX + 1, h.shape[0]),
+                max(u - LOW_PART_REACH_PX, 0):min(u + LOW_PART_REACH_PX + 1, h.shape[1])]
+    at = (v - box[0].start, u - box[1].start)
+    window = np.nan_to_num(h[box], nan=0.0, posinf=0.0, neginf=0.0)
+    # raised as find_candidates has it (opened 3 x 3); a speck inside a bin's filled ring is not the ring's
+    raised = cv2.morphologyEx((window > min_height).astype(np.uint8), cv2.MORPH_OPEN, np.ones((3, 3), np.uint8)) > 0
+    standing = _standing(raised, min_area_px)
+    if standing[at] and any(c.mask[v, u] for c in candidates):
+        return None
+    part = _low_part(window, raised, at, min_height) & ~standing
+    # where the part rises into a candidate without a step: a neighbour it merely touches stands up sharply there
+    joins = cv2.dilate(part.astype(np.uint8), np.ones((3, 3), np.uint8)) > 0
+    joins &= standing & (window < min_height + LOW_PART_STEP)
+    rows, cols = np.mgrid[box]
+    best, nearest = None, np.inf
+    for c in sorted(candidates, key=lambda c: int(c.mask.sum())):  # innermost first: it wins a tie
+        reached = joins & c.mask[box]
+        if reached.any():
+            distance = float(np.min((rows[reached] - v) ** 2 + (cols[reached] - u) ** 2))
+            if distance < nearest:
+                best, nearest = c, distance
+    return best
+
+
+def _low_part(window, raised, at, min_height) -> np.ndarray:
+    """(h, w) bool: the 8-connected region around ``at`` of the window's 5 x 5 median heights above the table's
+    noise (:func:`low_part_candidate`); empty when ``at`` is not above it."""
+    filtered = cv2.medianBlur(np.ascontiguousarray(window), 5)
+    table = filtered[~raised & (filtered < min_height)]  # a bin's floor lies inside the walls' filled ring
+    if table.size == 0:
+        return np.zeros(window.shape, dtype=bool)
+    level = np.median(table)
+    spread = 1.4826 * np.median(np.abs(table - level))
+    low = filtered > level + max(FLAT_HEIGHT_SIGMAS * spread, MIN_FLAT_HEIGHT)
+    if not low[at]:
+        return np.zeros(window.shape, dtype=bool)
+    _, labels = cv2.connectedComponents(low.astype(np.uint8), connectivity=8)
+    return labels == labels[at]
+
+
+def _standing(raised, min_area_px) -> np.ndarray:
+    """(h, w) bool: the 8-connected regions of ``raised`` as large as a candidate, or cut by the window's edge."""
+    _, labels, stats, _ = cv2.connectedComponentsWithStats(raised.astype(np.uint8), connectivity=8)
+    x, y, w, h, area = stats.T
+    keep = (area >= min_area_px) | (x == 0) | (y == 0) | (x + w == raised.shape[1]) | (y + h == raised.shape[0])
+    keep[0] = False
+    return keep[labels]
 
 
 def _nearest_pixel(mask, u, v) -> tuple[int, int]:
