@@ -65,6 +65,18 @@ def test_own_simulated_hand_reproduces_the_preset_within_a_millimetre(tmp_path):
     assert parse_hand(hand_to_toml(derived.hand)) == derived.hand
 
 
+def test_model_closing_measures_the_known_slides_along_their_rays(sliders):
+    """Each slider's tip travels its ray from 0 to its full travel, never past it, and in time order."""
+    from contourgrasp.sim.model_hand import close_model, model_closing, model_spec
+
+    spec = model_spec(sliders, fingertips=["left_tip", "right_tip"])
+    closing = model_closing(derive_hand(sliders, fingertips=["left_tip", "right_tip"]).hand, close_model(spec))
+    np.testing.assert_allclose(closing.travel, [0.04, 0.03], atol=1e-6)
+    np.testing.assert_allclose(closing.progress[:, 0], 0.0, atol=1e-6)
+    np.testing.assert_allclose(closing.progress[:, -1], [0.04, 0.03], atol=1e-6)
+    assert closing.times[0] == 0 and np.all(np.diff(closing.times) > 0)
+
+
 def test_the_approach_axis_decides_the_palm_plane(sliders):
     # approaching along the palm's x, the left finger slides along the approach: it does not close
     with pytest.raises(HandError, match="finger 'left_tip': its tip moves 0.00 mm on the palm plane"):

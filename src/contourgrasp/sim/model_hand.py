@@ -520,13 +520,17 @@ def _hand_axes(pointing: np.ndarray) -> np.ndarray:
     return np.stack([x, np.cross(z, x), z])
 
 
-def _with_virtual_starts(hand: Hand, closed: ClosedModel) -> Hand:
+def model_closing(hand: Hand, closed: ClosedModel) -> Closing:
+    """The free-air closing of ``closed`` as distances along ``hand``'s fitted trajectories (its virtual starts' source)."""
     progress = np.array([travelled(f, closed.tips[i, :, :2]) for i, f in enumerate(hand.fingers)])
     # an arc runs from the path's first point, which may lie off the fitted ellipse by the fit error: its
     # nearest point to the closed tip can fall that much short of the travel, which is the finger closed
     reached = np.minimum([f.travel for f in hand.fingers], progress.max(axis=1))
-    closing = Closing(names=closed.names, travel=reached, times=closed.times, travelled=progress)
-    starts = derive_virtual_starts(closing)
+    return Closing(names=closed.names, travel=reached, times=closed.times, travelled=progress)
+
+
+def _with_virtual_starts(hand: Hand, closed: ClosedModel) -> Hand:
+    starts = derive_virtual_starts(model_closing(hand, closed))
     fingers = tuple(replace(f, virtual_start=round(starts[f.name], 4) + 0.0) for f in hand.fingers)
     return replace(hand, fingers=fingers)
 
