@@ -231,6 +231,8 @@ def _add_synthesis_options(parser) -> None:
     parser.add_argument("--require-closure", action=argparse.BooleanOptionalAction,
                         help="only poses whose grasp points are in force closure")
     parser.add_argument("--quality-gain", type=_non_negative_float, help="cost term -gain * epsilon")
+    parser.add_argument("--centring-gain", type=_non_negative_float,
+                        help="cost term gain * (d / 10 mm)^2, d from the object's centre to the hand's pinch centre")
     parser.add_argument("--max-imbalance", type=_imbalance, metavar="SHARE|hand",
                         help="prefer poses whose equal finger pushes leave at most this net force, share of their "
                              "sum (0..1; 1: off), or 'hand': the hand file's own")
@@ -327,6 +329,7 @@ def _plan_options(args) -> dict:
         "friction": args.friction,
         "require_closure": args.require_closure,
         "quality_gain": args.quality_gain,
+        "centring_gain": args.centring_gain,
         "max_imbalance": args.max_imbalance,
         "depth_mode": getattr(args, "depth_mode", None),
         "footprint": getattr(args, "footprint", None),

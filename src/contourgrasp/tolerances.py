@@ -177,6 +177,9 @@ MIN_FLAT_HEIGHT = 0.0005
 #: mask; the whole image is searched only when the evidence reaches that window's edge.
 FLAT_WINDOW_PX = 96
 
+#: The distance over which ``Safeguards.centring_gain`` costs its gain once, m (``synthesis.cost.centring_distance``).
+CENTRING_SCALE = 0.01
+
 #: A target pixel on a low-lying part (below ``MIN_HEIGHT``, above the table's noise) is followed to the
 #: candidate it belongs to within this distance, pixels (``perception.candidates.low_part_candidate``):
 #: the YCB fork, seen from the bench's camera, is 150-170 px long, its raised pieces at either end.

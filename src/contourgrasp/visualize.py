@@ -103,7 +103,8 @@ def plan_figure(plan: GraspPlan) -> Figure:
     ax.set_title(
         f"{plan.hand.name}: pose x={x:.3f} m, y={y:.3f} m, yaw={np.degrees(yaw):.0f}°\n"
         f"cost {c.total:.1f} = curvature {c.curvature:.1f} + ratio {c.ratio:.1f} + miss {c.miss:.0f}"
-        f"  ({plan.curvature_mode} curvature, {plan.efd.harmonics} harmonics)",
+        + "".join(f" + {name} {value:.1f}" for name, value in (("quality", c.quality), ("centring", c.centring)) if value)
+        + f"  ({plan.curvature_mode} curvature, {plan.efd.harmonics} harmonics)",
         fontsize=10,
     )
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)

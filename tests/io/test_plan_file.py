@@ -18,11 +18,12 @@ def test_plan_json_schema():
     assert set(data) >= {"pose", "cost", "curvature_mode", "fingers", "efd", "alternatives", "timing_ms", "grid",
                          "safeguards", "quality"}
     assert set(data["pose"]) == {"x", "y", "yaw"}
-    assert set(data["cost"]) == {"total", "curvature", "ratio", "miss", "quality"}
+    assert set(data["cost"]) == {"total", "curvature", "ratio", "miss", "quality", "centring"}
     assert data["quality"]["force_closure"] is True and data["quality"]["epsilon"] > 0  # three fingers around a can
     assert 0.0 <= data["quality"]["imbalance"] <= 1.0
     assert data["safeguards"] == {"finger_thickness": False, "clearance": 0.0, "friction": 0.5,
-                                  "require_closure": False, "quality_gain": 0.0, "max_imbalance": 1.0}
+                                  "require_closure": False, "quality_gain": 0.0, "max_imbalance": 1.0,
+                                  "centring_gain": 0.0}
     finger_keys = {"name", "grasp_point", "t", "lambda", "curvature", "concave", "distance", "start",
                    "virtual_start", "missed", "gap"}
     assert all(set(f) == finger_keys for f in data["fingers"])

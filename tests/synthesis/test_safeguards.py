@@ -10,6 +10,7 @@ import contourgrasp as cg
 from contourgrasp import InputError, NoFeasibleGrasp
 from contourgrasp.hand import Finger, Hand, Ray
 from contourgrasp.synthesis import Safeguards, fingers_clear, grasp_imbalance
+from contourgrasp.synthesis.cost import centring_distance
 from contourgrasp.synthesis._cost_kernels import contact_imbalance
 
 FAST = {"yaw_step": math.radians(10), "xy_step": 0.02}
@@ -242,7 +243,39 @@ def test_the_screens_compiled_balance_is_the_squeezes_on_a_disc_and_equals_it_on
         grasp_imbalance(blob, t, touching), abs=1e-12)
 
 
+def test_the_pinch_centre_is_midway_between_thumb_and_the_nearest_closed_tip():
+    hand = cg.load_hand("five-finger-linear")  # thumb closes to (-25.5, 109.5) mm, the index to (-26.3, 145.1)
+    np.testing.assert_allclose(hand.pinch_centre, (hand.ends[0] + hand.ends[1]) / 2)
+    assert np.linalg.norm(hand.ends[1] - hand.ends[0]) < min(np.linalg.norm(hand.ends[2:] - hand.ends[0], axis=1))
+
+
+def test_centring_distance_is_measured_in_the_hand_frame():
+    hand = cg.load_hand("five-finger-linear")
+    c = hand.pinch_centre
+    # the hand turned 90 deg: its pinch centre (cx, cy) lies at (-cy, cx) from its origin in the image
+    poses = np.array([[0.0, 0.0, math.pi / 2], [0.0, 0.0, math.pi / 2], [0.01, 0.0, 0.0]])
+    locus = np.array([-c[1], c[0]])
+    d = centring_distance(hand, poses[:2], locus)
+    assert d[0] == pytest.approx(0.0, abs=1e-12)
+    assert centring_distance(hand, poses[2:], c + [0.01 + 0.03, 0.04])[0] == pytest.approx(0.05)
+
+
+def test_the_centring_gain_adds_its_cost_and_brings_the_object_to_the_pinch_centre():
+    contour, hand = cg.example_contour("bottle"), cg.load_hand("five-finger-linear")
+    plain = cg.synthesize(contour, hand, **FAST)
+    centred = cg.synthesize(contour, hand, centring_gain=1000.0, **FAST)
+    locus = cg.efd.fit(contour, 4).locus
+    def distance(plan):
+        return float(centring_distance(hand, np.array([plan.pose]), locus)[0])
+    assert distance(centred) <= distance(plain) and distance(centred) < 0.02  # within a grid step of it
+    assert plain.cost.centring == 0.0
+    assert centred.cost.centring == pytest.approx(1000.0 * (distance(centred) / 0.01) ** 2)
+    assert centred.cost.total == pytest.approx(centred.cost.curvature + centred.cost.ratio + centred.cost.miss
+                                               + centred.cost.quality + centred.cost.centring)
+
+
 @pytest.mark.parametrize("option", [{"clearance": -0.01}, {"friction": float("nan")}, {"quality_gain": -1.0},
+                                    {"centring_gain": -1.0}, {"centring_gain": float("inf")},
                                     {"max_imbalance": 1.5}, {"max_imbalance": -0.1}])
 def test_bad_safeguards_are_refused_by_name(option):
     with pytest.raises(InputError, match=next(iter(option))):

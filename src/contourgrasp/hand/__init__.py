@@ -191,6 +191,23 @@ class Hand:
         """(2,) float: mean of the fully closed fingertips, hand frame."""
         return self.ends.mean(axis=0)
 
+    @property
+    def pinch_centre(self) -> np.ndarray:
+        """(2,) float: midway between the thumb's closed tip and the closed tip nearest it, hand frame.
+
+        The thumb is the first required finger, else the first finger (as in the bench's
+        centroid baseline). Where the lifting poses of a brute-force search put the object's
+        centre, on our five-finger hand and the Inspire alike (README, "The object between thumb
+        and index"); the thumb and the finger opposite it hold what the others only touch.
+        """
+        thumb = next((i for i, f in enumerate(self.fingers) if f.required), 0)
+        ends = self.ends
+        others = np.delete(np.arange(len(ends)), thumb)
+        if len(others) == 0:
+            return ends[thumb]
+        nearest = others[np.argmin(np.linalg.norm(ends[others] - ends[thumb], axis=1))]
+        return (ends[thumb] + ends[nearest]) / 2
+
     def segments(self) -> HandSegments:
         """All fingers' trajectory chords, stacked for vectorised intersection."""
         starts, ends, finger, lam0 = [], [], [], []

@@ -24,6 +24,7 @@ which is the thesis's setting)::
     friction = 0.5
     require_closure = false
     quality_gain = 0.0
+    centring_gain = 0.0          # prefer poses with the object between thumb and index (Safeguards)
     max_imbalance = 1.0          # prefer poses whose equal finger pushes leave at most this share of net force
                                  # (1: off), or "hand": the hand file's own (Hand.max_imbalance)
     descent = false              # the open 3-D hand's descent onto the height map (synthesis.Descent)
@@ -82,6 +83,7 @@ class _PlannerSchema(BaseModel):
     friction: Annotated[float, Field(ge=0, le=tol.MAX_FRICTION, allow_inf_nan=False)] | None = None
     require_closure: bool | None = None
     quality_gain: NonNegative | None = None
+    centring_gain: NonNegative | None = None
     max_imbalance: Literal["hand"] | Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] | None = None
     descent: bool | None = None
     slice_contour: bool | Literal["unbalanced"] | None = None

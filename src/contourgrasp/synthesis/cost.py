@@ -11,7 +11,9 @@ The cost of a pose has three parts, summed over touching fingers i:
   gains and cannot steer toward simultaneous contact (see
   :func:`ratio_cost`, ``form="linear"``), and gains of 1e4 against
   distances of centimeters point to a square;
-* miss: ``hand.miss_penalty`` per finger that closes on air.
+* miss: ``hand.miss_penalty`` per finger that closes on air;
+* beyond the thesis, with :class:`Safeguards`: ``-quality_gain * epsilon`` and
+  ``centring_gain * (d / CENTRING_SCALE)^2`` (:func:`centring_distance`).
 
 The per-pose loops are compiled (:mod:`contourgrasp.synthesis._cost_kernels`).
 """
@@ -22,6 +24,7 @@ from typing import Literal
 
 import numpy as np
 
+from .. import tolerances as tol
 from ..errors import PlannerError
 from ..hand import Hand
 from ._cost_kernels import ratio_cost_rows, score_poses
@@ -81,8 +84,34 @@ def distance(p_virt, p_grasp):
     return float(np.linalg.norm(gap)) if gap.ndim == 1 else np.linalg.norm(gap, axis=-1)
 
 
+def centring_distance(hand: Hand, poses, locus) -> np.ndarray:
+    """(p,) float: distance from ``hand.pinch_centre`` to the object's centre ``locus``, in the hand frame, m.
+
+    Parameters
+    ----------
+    hand : Hand
+    poses : (p, 3) float
+        (x, y, yaw) of the hand in the image plane.
+    locus : (2,) float
+        The object's centre in the image plane, m.
+
+    Examples
+    --------
+    >>> from contourgrasp import load_hand
+    >>> hand = load_hand("five-finger-linear")
+    >>> x, y = -hand.pinch_centre  # the hand's origin where the pinch centre falls on the image's origin
+    >>> float(centring_distance(hand, np.array([[x, y, 0.0]]), np.zeros(2))[0])
+    0.0
+    """
+    poses = np.asarray(poses, dtype=float)
+    rx, ry = locus[0] - poses[:, 0], locus[1] - poses[:, 1]
+    c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
+    cx, cy = hand.pinch_centre
+    return np.hypot(c * rx + s * ry - cx, c * ry - s * rx - cy)  # R(yaw)^T (locus - xy), less the pinch centre
+
+
 def score(hand: Hand, poses, touching, lam, t, point, curv, start_inside, d_min, clear, epsilon,
-          safeguards: Safeguards, n_yaw: int | None = None, *, imbalance=None) -> PoseEvaluation:
+          safeguards: Safeguards, n_yaw: int | None = None, *, imbalance=None, locus=None) -> PoseEvaluation:
     """Constraints and cost of each pose from the inner problem's solutions.
 
     Implements eq 3.34 and 3.41: the cost f = sum_i alpha_i C_curvature(t_i) + C_ratio
@@ -112,6 +141,9 @@ def score(hand: Hand, poses, touching, lam, t, point, curv, start_inside, d_min,
         The period of the poses' yaws, for a grid (yaw fastest); None for any list of poses.
     imbalance : (p,) float, optional
         :func:`contourgrasp.quality.imbalance` of the grasp points (NaN or None: not computed).
+    locus : (2,) float, optional
+        The object's centre in the image plane (the EFD locus), for ``safeguards.centring_gain``
+        (None: no centring cost).
 
     Returns
     -------
@@ -130,6 +162,9 @@ def score(hand: Hand, poses, touching, lam, t, point, curv, start_inside, d_min,
     if safeguards.balances:
         feasible &= imbalance <= safeguards.max_imbalance
     cost_quality = -safeguards.quality_gain * np.nan_to_num(epsilon) if safeguards.quality_gain else np.zeros(len(poses))
+    cost_centring = np.zeros(len(poses))
+    if safeguards.centring_gain and locus is not None:
+        cost_centring = safeguards.centring_gain * centring_distance(hand, poses, locus) ** 2 / tol.CENTRING_SCALE ** 2
     return PoseEvaluation(
         poses=poses,
         touching=touching,
@@ -150,5 +185,6 @@ def score(hand: Hand, poses, touching, lam, t, point, curv, start_inside, d_min,
         cost_ratio=cost_ratio,
         cost_miss=cost_miss,
         cost_quality=cost_quality,
-        cost=cost_curvature + cost_ratio + cost_miss + cost_quality,
+        cost_centring=cost_centring,
+        cost=cost_curvature + cost_ratio + cost_miss + cost_quality + cost_centring,
     )

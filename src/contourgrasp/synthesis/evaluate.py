@@ -77,7 +77,7 @@ def evaluate_poses(
                                 for rows in np.array_split(np.arange(len(poses)), -(-len(poses) // tol.POSE_BATCH))])
     epsilon, imbalance = grade(model, point, t, touching, safeguards)
     return score(hand, poses, touching, lam, t, point, curv, start_inside, d_min, clear, epsilon, safeguards,
-                 imbalance=imbalance)
+                 imbalance=imbalance, locus=model.locus)
 
 
 def replace_rows(evaluation: PoseEvaluation, rows, source: PoseEvaluation, source_rows) -> PoseEvaluation:

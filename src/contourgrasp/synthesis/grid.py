@@ -107,7 +107,8 @@ class SearchGrid:
 
 
 def screen_grid(
-    model: EFD, hand: Hand, grid: SearchGrid, *, curvature: CurvatureMode = "paper", samples: int = tol.EFD_SAMPLES
+    model: EFD, hand: Hand, grid: SearchGrid, *, curvature: CurvatureMode = "paper", samples: int = tol.EFD_SAMPLES,
+    centring_gain: float = 0.0,
 ) -> PoseEvaluation:
     """Evaluate every pose of a grid fast, to within the EFD polygon's accuracy.
 
@@ -125,11 +126,13 @@ def screen_grid(
     grid : SearchGrid
     curvature : {"paper", "geometric"}
     samples : int
+    centring_gain : float
+        The one safeguard of the screen: its cost orders the poses evaluated exactly.
 
     Returns
     -------
     PoseEvaluation
-        Of ``grid.poses(model.locus)``, without safeguards.
+        Of ``grid.poses(model.locus)``, without safeguards but the centring cost.
     """
     xs, ys, yaws = grid.axes(model.locus)
     contour_t, contour = polygon(model, samples)
@@ -150,7 +153,8 @@ def screen_grid(
     poses = grid.poses(model.locus)
     n = len(poses)
     return score(hand, poses, touching, np.where(touching, lam, np.nan), t, point, curv, start_inside,
-                 grid.d_min, np.ones(n, bool), np.full(n, np.nan), Safeguards(), n_yaw=len(yaws))
+                 grid.d_min, np.ones(n, bool), np.full(n, np.nan), Safeguards(centring_gain=centring_gain),
+                 n_yaw=len(yaws), locus=model.locus)
 
 
 def distinct_best(result: PoseEvaluation, grid: SearchGrid, k: int, block: int = 512) -> list[int]:

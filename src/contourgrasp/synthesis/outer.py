@@ -63,6 +63,7 @@ def search(
     friction: float = 0.5,
     require_closure: bool = False,
     quality_gain: float = 0.0,
+    centring_gain: float = 0.0,
     max_imbalance: float | Literal["hand"] = 1.0,
     balance_required: bool = False,
     balanced_alternative: Callable[[], GraspPlan] | None = None,
@@ -97,7 +98,7 @@ def search(
         After the grid, refine its best ``tol.REFINE_STARTS`` distinct poses continuously
         (:func:`~contourgrasp.synthesis.refine_poses`, under the same constraints) and keep the
         better; ``refinement`` reports the gain.
-    finger_thickness, clearance, friction, require_closure, quality_gain, max_imbalance
+    finger_thickness, clearance, friction, require_closure, quality_gain, centring_gain, max_imbalance
         The :class:`~contourgrasp.synthesis.Safeguards` (all off: the thesis's problem).
         ``friction`` is also the mu of the plan's reported ``quality``.
     max_imbalance : float or "hand"
@@ -175,7 +176,7 @@ def search(
     safeguards = Safeguards(finger_thickness=check.flag("finger_thickness", finger_thickness, error=PlannerError),
                             clearance=clearance, friction=friction,
                             require_closure=check.flag("require_closure", require_closure, error=PlannerError),
-                            quality_gain=quality_gain, max_imbalance=max_imbalance)
+                            quality_gain=quality_gain, max_imbalance=max_imbalance, centring_gain=centring_gain)
 
     clock = time.perf_counter()
     small_objects = check.flag("small_objects", small_objects, error=PlannerError)
@@ -220,7 +221,8 @@ def _search_outline(contour, *, hand: Hand, grid: SearchGrid, safeguards: Safegu
     fewest = max(tol.SMALL_OBJECT_TOUCHING, sum(f.required for f in hand.fingers))
     fewest = min(fewest, hand.min_touching) if small_objects else hand.min_touching
     counts = range(hand.min_touching, fewest - 1, -1)
-    screen = screen_grid(model, replace(hand, min_touching=fewest), grid, curvature=curvature)
+    screen = screen_grid(model, replace(hand, min_touching=fewest), grid, curvature=curvature,
+                         centring_gain=safeguards.centring_gain)
     touch_counts = np.count_nonzero(screen.touching, axis=1)
     share = np.full(len(screen.poses), np.nan)  # the squeeze's balance per screened pose, filled as attempts need it
     searched = time.perf_counter()
@@ -540,6 +542,7 @@ def _cost(result: PoseEvaluation, i: int) -> Cost:
         ratio=float(result.cost_ratio[i]),
         miss=float(result.cost_miss[i]),
         quality=float(result.cost_quality[i]),
+        centring=float(result.cost_centring[i]),
     )
 
 

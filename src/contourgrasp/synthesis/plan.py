@@ -52,7 +52,7 @@ class PoseEvaluation:
         The squeeze's imbalance at the grasp points (:func:`contourgrasp.quality.imbalance`; NaN
         where not computed).
     feasible : (p,) bool
-    cost_curvature, cost_ratio, cost_miss, cost_quality, cost : (p,) float
+    cost_curvature, cost_ratio, cost_miss, cost_quality, cost_centring, cost : (p,) float
     """
 
     poses: np.ndarray
@@ -74,18 +74,20 @@ class PoseEvaluation:
     cost_ratio: np.ndarray
     cost_miss: np.ndarray
     cost_quality: np.ndarray
+    cost_centring: np.ndarray
     cost: np.ndarray
 
 
 @dataclass(frozen=True)
 class Cost:
-    """The cost of a pose (see eq 3.34) and its parts (``quality``: :class:`Safeguards` ``quality_gain``)."""
+    """The cost of a pose (see eq 3.34) and its parts (``quality``, ``centring``: :class:`Safeguards`' gains)."""
 
     total: float
     curvature: float
     ratio: float
     miss: float
     quality: float = 0.0
+    centring: float = 0.0
 
 
 @dataclass(frozen=True, eq=False)

@@ -52,6 +52,11 @@ class Safeguards:
     quality_gain : float
         Cost term ``-quality_gain * epsilon`` (Ferrari-Canny L1, wrenches about
         the EFD locus, torque over the contour's largest radius about it).
+    centring_gain : float
+        Cost term ``centring_gain * (d / CENTRING_SCALE)^2``, d the distance in the hand frame from the
+        object's centre (the EFD locus) to the hand's pinch centre (:attr:`Hand.pinch_centre
+        <contourgrasp.hand.Hand.pinch_centre>`): prefer poses that put the object between the thumb
+        and the finger nearest it (beyond the thesis; README, "The object between thumb and index").
     max_imbalance : float
         Reject poses whose equal pushes along the grasp points' normals leave a net force of
         more than this share of their sum (:func:`contourgrasp.quality.imbalance`; in [0, 1],
@@ -73,6 +78,7 @@ class Safeguards:
     require_closure: bool = False
     quality_gain: float = 0.0
     max_imbalance: float = 1.0
+    centring_gain: float = 0.0
 
     def __post_init__(self):
         check.flag("finger_thickness", self.finger_thickness, error=PlannerError)
@@ -81,6 +87,7 @@ class Safeguards:
         check.flag("require_closure", self.require_closure, error=PlannerError)
         check.non_negative("quality_gain", self.quality_gain, error=PlannerError)
         check.bounded("max_imbalance", self.max_imbalance, 1.0, "", error=PlannerError)
+        check.non_negative("centring_gain", self.centring_gain, error=PlannerError)
 
     @property
     def balances(self) -> bool:
