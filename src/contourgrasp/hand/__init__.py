@@ -192,15 +192,20 @@ class Hand:
         return self.ends.mean(axis=0)
 
     @property
-    def pinch_centre(self) -> np.ndarray:
-        """(2,) float: midway between the thumb's closed tip and the closed tip nearest it, hand frame.
+    def thumb_index(self) -> int:
+        """The thumb's index in ``fingers``: the first required finger, else the first."""
+        return next((i for i, f in enumerate(self.fingers) if f.required), 0)
 
-        The thumb is the first required finger, else the first finger (as in the bench's
-        centroid baseline). Where the lifting poses of a brute-force search put the object's
+    @property
+    def pinch_centre(self) -> np.ndarray:
+        """(2,) float: midway between the thumb's closed tip (:attr:`thumb_index`) and the closed tip nearest it,
+        hand frame.
+
+        Where the lifting poses of a brute-force search put the object's
         centre, on our five-finger hand and the Inspire alike (README, "The object between thumb
         and index"); the thumb and the finger opposite it hold what the others only touch.
         """
-        thumb = next((i for i, f in enumerate(self.fingers) if f.required), 0)
+        thumb = self.thumb_index
         ends = self.ends
         others = np.delete(np.arange(len(ends)), thumb)
         if len(others) == 0:

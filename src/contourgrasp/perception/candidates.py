@@ -32,13 +32,13 @@ from scipy import ndimage
 from .. import validation
 from ..errors import PerceptionError, SegmentationError
 from ..tolerances import (CANDIDATE_DEPTH_STEP, CONTAINER_FLOOR_AREA, ENCLOSED_FRACTION, FLAT_HEIGHT_SIGMAS,
-                          LOW_PART_REACH_PX, LOW_PART_STEP, MIN_AREA_PX, MIN_FLAT_HEIGHT, MIN_HEIGHT, SENSOR_RANGE,
+                          LOW_PART_REACH_PX, LOW_PART_STEP, MIN_AREA_PX, MIN_HEIGHT, SENSOR_RANGE,
                           SIMILAR_SIZE)
-from ._pixels import check_pixel
+from ._pixels import check_pixel, connected_to
 from .camera import Intrinsics, as_depth, check_intrinsics, valid_depth
 from .region import mask_contour, touching_regions
-from .segment_depth import raised_pixels
-from .table import Plane, heights
+from .segment_depth import open_specks, raised_pixels
+from .table import Plane, above_table_noise, heights, median_heights
 
 #: The target rules of :func:`choose_target`.
 TARGET_RULES: tuple[str, ...] = ("hand", "largest", "centre")
@@ -477,7 +477,7 @@ def low_part_candidate(candidates, pixel, pixel_heights, *, min_height: float = 
     at = (v - box[0].start, u - box[1].start)
     window = np.nan_to_num(h[box], nan=0.0, posinf=0.0, neginf=0.0)
     # raised as find_candidates has it (opened 3 x 3); a speck inside a bin's filled ring is not the ring's
-    raised = cv2.morphologyEx((window > min_height).astype(np.uint8), cv2.MORPH_OPEN, np.ones((3, 3), np.uint8)) > 0
+    raised = open_specks(window > min_height)
     standing = _standing(raised, min_area_px)
     if standing[at] and any(c.mask[v, u] for c in candidates):
         return None
@@ -499,17 +499,14 @@ def low_part_candidate(candidates, pixel, pixel_heights, *, min_height: float = 
 def _low_part(window, raised, at, min_height) -> np.ndarray:
     """(h, w) bool: the 8-connected region around ``at`` of the window's 5 x 5 median heights above the table's
     noise (:func:`low_part_candidate`); empty when ``at`` is not above it."""
-    filtered = cv2.medianBlur(np.ascontiguousarray(window), 5)
-    table = filtered[~raised & (filtered < min_height)]  # a bin's floor lies inside the walls' filled ring
-    if table.size == 0:
-        return np.zeros(window.shape, dtype=bool)
-    level = np.median(table)
-    spread = 1.4826 * np.median(np.abs(table - level))
-    low = filtered > level + max(FLAT_HEIGHT_SIGMAS * spread, MIN_FLAT_HEIGHT)
-    if not low[at]:
-        return np.zeros(window.shape, dtype=bool)
-    _, labels = cv2.connectedComponents(low.astype(np.uint8), connectivity=8)
-    return labels == labels[at]
+    filtered = median_heights(window)
+    table = ~raised & (filtered < min_height)  # a bin's floor lies inside the walls' filled ring
+    seed = np.zeros(window.shape, dtype=bool)
+    if not table.any():
+        return seed
+    low = above_table_noise(filtered, table, FLAT_HEIGHT_SIGMAS)
+    seed[at] = low[at]  # connected_to would keep the background for a seed on it
+    return connected_to(low, seed)
 
 
 def _standing(raised, min_area_px) -> np.ndarray:

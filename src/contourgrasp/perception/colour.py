@@ -33,12 +33,12 @@ from scipy import ndimage
 from .. import validation
 from ..errors import PerceptionError
 from ..tolerances import (COLOUR_DISTANCE, EVIDENCE_OPEN_PX, FLAT_GAP_PX, FLAT_HEIGHT_SIGMAS, FLAT_WINDOW_PX, HALO_PX,
-                          LIGHTNESS_WEIGHT, MAX_COLOUR_OFFSET_PX, MIN_AREA_PX, MIN_FLAT_HEIGHT, MIN_HEIGHT, REGISTRATION_MARGIN_PX,
+                          LIGHTNESS_WEIGHT, MAX_COLOUR_OFFSET_PX, MIN_AREA_PX, MIN_HEIGHT, REGISTRATION_MARGIN_PX,
                           SHADOW_LIGHTNESS)
 from ._pixels import components, connected_to, dilate, grown_box, opening, pixel_box
 from .camera import as_depth, as_rgb, check_intrinsics, valid_depth
 from .region import Segmentation, make_segmentation, pick_object
-from .table import heights
+from .table import above_table_noise, heights, median_heights
 
 
 def add_flat_parts(
@@ -253,7 +253,7 @@ def _unlike_in(image, depth_mask, halo, table, height, options):
     unlike = cv2.transform(per_channel, weights) > np.float64(options.colour_distance) ** 2
     unlike |= lab[..., 0] < options.shadow_lightness * table_lab[0]
     if height is not None:
-        unlike |= _above_table_noise(height, ring, options.height_sigmas)
+        unlike |= above_table_noise(median_heights(height), ring, options.height_sigmas)
         unlike &= ~_other_objects(height > options.min_height, depth_mask, options.min_area_px)
     evidence = opening(unlike, EVIDENCE_OPEN_PX) & ~depth_mask
     return _joined(evidence, depth_mask, options.gap_px, options.min_area_px) & ~depth_mask
@@ -269,16 +269,6 @@ def _other_objects(standing, mask, min_area_px) -> np.ndarray:
     other = areas >= min_area_px
     other[0] = False
     return other[labels]
-
-
-def _above_table_noise(height, ring, sigmas) -> np.ndarray:
-    """(H, W) bool: the 5 x 5 median of ``height`` above its median on ``ring`` by more than ``sigmas`` times its
-    spread there and ``MIN_FLAT_HEIGHT``."""
-    filtered = cv2.medianBlur(np.ascontiguousarray(height, dtype=np.float32), 5)
-    on_table = filtered[ring]
-    level = np.median(on_table)
-    spread = 1.4826 * np.median(np.abs(on_table - level))
-    return filtered > level + max(sigmas * spread, MIN_FLAT_HEIGHT)
 
 
 def _joined(evidence, mask, gap_px, min_area_px) -> np.ndarray:

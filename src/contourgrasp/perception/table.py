@@ -10,12 +10,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 
+import cv2
 import numpy as np
 
 from .. import validation
 from ..errors import PerceptionError, SegmentationError
-from ..tolerances import (MAX_TABLE_TILT, MIN_PLANE_FRACTION, PLANE_ITERATIONS, PLANE_SAMPLE, PLANE_STRIDE,
-                          PLANE_THRESHOLD, SENSOR_RANGE)
+from ..tolerances import (MAX_TABLE_TILT, MIN_FLAT_HEIGHT, MIN_PLANE_FRACTION, PLANE_ITERATIONS, PLANE_SAMPLE,
+                          PLANE_STRIDE, PLANE_THRESHOLD, SENSOR_RANGE)
 from ._frame import memoised
 from .camera import Intrinsics, as_depth, check_intrinsics, pixel_points, valid_depth
 
@@ -266,3 +267,26 @@ def footprint_pixels(depth, intrinsics: Intrinsics, plane: Plane, rows, cols) ->
     on_table = points - plane.height(points)[:, None] * plane.normal
     with np.errstate(divide="ignore", invalid="ignore"):
         return intrinsics.project(on_table)
+
+
+def median_heights(height) -> np.ndarray:
+    """(H, W) float32: ``height`` median-filtered over 5 x 5 pixels: the noise cut about fivefold, a part's edge kept."""
+    return cv2.medianBlur(np.ascontiguousarray(height, dtype=np.float32), 5)
+
+
+def above_table_noise(filtered, ring, sigmas: float) -> np.ndarray:
+    """(H, W) bool: the pixels of ``filtered`` (:func:`median_heights`) above its median on ``ring`` by more than
+    ``sigmas`` times its spread there (the median absolute deviation scaled to a Gaussian's sigma) and
+    ``MIN_FLAT_HEIGHT``; ``ring`` (H, W) bool, the table's pixels, holds one at least.
+
+    Examples
+    --------
+    >>> h = np.zeros((20, 20), np.float32); h[::2, ::2] = 0.001; h[5:15, 8:12] = 0.004
+    >>> low = above_table_noise(median_heights(h), h < 0.002, 5.0)
+    >>> bool(low[10, 10]), bool(low[2, 2])
+    (True, False)
+    """
+    on_table = filtered[ring]
+    level = np.median(on_table)
+    spread = 1.4826 * np.median(np.abs(on_table - level))
+    return filtered > level + max(sigmas * spread, MIN_FLAT_HEIGHT)

@@ -256,7 +256,7 @@ def centroid_pose(contour_xy, hand: Hand) -> np.ndarray:
 
 def _thumb_direction(hand: Hand) -> tuple[float, float]:
     """Closing direction of the first required finger (the thumb), else of the first finger."""
-    finger = next((f for f in hand.fingers if f.required), hand.fingers[0])
+    finger = hand.fingers[hand.thumb_index]
     if not isinstance(finger.trajectory, Ray):
         raise HandError(f"hand {hand.name!r}: the centroid baseline needs a thumb that closes on a ray")
     return finger.trajectory.closing_direction
