@@ -180,6 +180,10 @@ FLAT_WINDOW_PX = 96
 #: The distance over which ``Safeguards.centring_gain`` costs its gain once, m (``synthesis.cost.centring_distance``).
 CENTRING_SCALE = 0.01
 
+#: The largest ``centring_gain``: the term stays finite and printable (d^2 / CENTRING_SCALE^2 is 1e4 for a metre of
+#: distance), and 1e6 already outweighs every other part of the cost by orders of magnitude.
+MAX_CENTRING_GAIN = 1e6
+
 #: A target pixel on a low-lying part (below ``MIN_HEIGHT``, above the table's noise) is followed to the
 #: candidate it belongs to within this distance, pixels (``perception.candidates.low_part_candidate``):
 #: the YCB fork, seen from the bench's camera, is 150-170 px long, its raised pieces at either end.

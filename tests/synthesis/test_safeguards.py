@@ -275,7 +275,7 @@ def test_the_centring_gain_adds_its_cost_and_brings_the_object_to_the_pinch_cent
 
 
 @pytest.mark.parametrize("option", [{"clearance": -0.01}, {"friction": float("nan")}, {"quality_gain": -1.0},
-                                    {"centring_gain": -1.0}, {"centring_gain": float("inf")},
+                                    {"centring_gain": -1.0}, {"centring_gain": float("inf")}, {"centring_gain": 1e7},
                                     {"max_imbalance": 1.5}, {"max_imbalance": -0.1}])
 def test_bad_safeguards_are_refused_by_name(option):
     with pytest.raises(InputError, match=next(iter(option))):

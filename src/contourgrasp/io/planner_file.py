@@ -38,7 +38,8 @@ which is the thesis's setting)::
 Unknown keys, wrong types and impossible values are refused with
 :class:`PlannerFileError` naming the file and the field; so is a file that is not UTF-8 text or
 TOML. The bounds are the search's (:mod:`contourgrasp.tolerances`): harmonics at most
-``MAX_HARMONICS``, lengths at most ``MAX_SEARCH_LENGTH``, friction at most ``MAX_FRICTION``, and
+``MAX_HARMONICS``, lengths at most ``MAX_SEARCH_LENGTH``, friction at most ``MAX_FRICTION``, ``centring_gain`` at
+most ``MAX_CENTRING_GAIN``, and
 a grid of at most ``MAX_GRID_POSES`` poses.
 """
 
@@ -83,7 +84,7 @@ class _PlannerSchema(BaseModel):
     friction: Annotated[float, Field(ge=0, le=tol.MAX_FRICTION, allow_inf_nan=False)] | None = None
     require_closure: bool | None = None
     quality_gain: NonNegative | None = None
-    centring_gain: NonNegative | None = None
+    centring_gain: Annotated[float, Field(ge=0, le=tol.MAX_CENTRING_GAIN, allow_inf_nan=False)] | None = None
     max_imbalance: Literal["hand"] | Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] | None = None
     descent: bool | None = None
     slice_contour: bool | Literal["unbalanced"] | None = None

@@ -53,7 +53,7 @@ class Safeguards:
         Cost term ``-quality_gain * epsilon`` (Ferrari-Canny L1, wrenches about
         the EFD locus, torque over the contour's largest radius about it).
     centring_gain : float
-        Cost term ``centring_gain * (d / CENTRING_SCALE)^2``, d the distance in the hand frame from the
+        Cost term ``centring_gain * (d / CENTRING_SCALE)^2`` (at most ``tolerances.MAX_CENTRING_GAIN``), d the distance in the hand frame from the
         object's centre (the EFD locus) to the hand's pinch centre (:attr:`Hand.pinch_centre
         <contourgrasp.hand.Hand.pinch_centre>`): prefer poses that put the object between the thumb
         and the finger nearest it (beyond the thesis; README, "The object between thumb and index").
@@ -87,7 +87,7 @@ class Safeguards:
         check.flag("require_closure", self.require_closure, error=PlannerError)
         check.non_negative("quality_gain", self.quality_gain, error=PlannerError)
         check.bounded("max_imbalance", self.max_imbalance, 1.0, "", error=PlannerError)
-        check.non_negative("centring_gain", self.centring_gain, error=PlannerError)
+        check.bounded("centring_gain", self.centring_gain, tol.MAX_CENTRING_GAIN, "", error=PlannerError)
 
     @property
     def balances(self) -> bool:
