@@ -11,7 +11,7 @@ from contourgrasp.errors import HandError, NoFeasibleGrasp, PerceptionError, Pla
 from contourgrasp.hand import Hand, SampledChain, chain_joints, chain_tip
 from contourgrasp.perception import HeightMap
 from contourgrasp.synthesis.descent import (Descent, body_names, check_candidates, descent_clearance, descent_feasible,
-                                            descent_floor)
+                                            descent_floor, height_base)
 
 CELL = 0.002
 CAMERA = 0.7  # camera height above the table: a point at planning depth z is 0.7 - z above it
@@ -344,3 +344,23 @@ def test_a_low_ring_the_closing_fingers_would_cross_blocks_every_pose_and_says_s
     with pytest.raises(NoFeasibleGrasp, match="blocked by a neighbouring object or the bin wall: .* would run a "
                                               "finger into a neighbouring object or the bin wall while the hand closes"):
         synthesis.search(contour, hand, descent=Descent(heights, 0.02, 0.02, closing=True), **options)
+
+
+def test_a_yes_no_walk_is_exact_below_its_threshold_and_no_lower_above_it(hand):
+    """``only_below`` skips cells that cannot bring a gap below it: the closing sweep's speed-up changes no answer."""
+    from contourgrasp.synthesis._descent_kernels import map_clearances
+    from contourgrasp.synthesis.descent import _open_hand
+
+    rng = np.random.default_rng(5)
+    bumps = np.c_[rng.uniform(-0.06, 0.06, (6, 2)), rng.uniform(0.0, 0.12, 6)]
+    heights = scene(lambda x, y: sum(np.where(np.hypot(x - a, y - b) < 0.02, h, 0.0) for a, b, h in bumps))
+    poses = np.c_[rng.uniform(-0.1, 0.1, (200, 2)), rng.uniform(-np.pi, np.pi, 200)]
+    bodies = _open_hand(hand)
+    base = height_base(hand, poses, 0.02, np.asarray(heights.table_normal))
+    full = map_clearances(heights, hand, poses, base, bodies.capsules, bodies.radii)
+    for threshold in (0.0, 0.03):
+        fast = map_clearances(heights, hand, poses, base, bodies.capsules, bodies.radii,
+                              only_below=np.full(len(poses), threshold))
+        low = full < threshold
+        assert 0 < low.sum() < low.size
+        assert np.array_equal(fast[low], full[low]) and (fast[~low] >= threshold).all()

@@ -18,7 +18,7 @@ from numba import njit
 from ..tolerances import VERTICAL_AXIS
 
 
-def map_clearances(heights, hand, poses, base, ends, radii, stop=None) -> np.ndarray:
+def map_clearances(heights, hand, poses, base, ends, radii, stop=None, only_below=None) -> np.ndarray:
     """(p, n + 1) float: the least gap over ``heights`` (a HeightMap's conservative layer) of each capsule
     (``ends`` (n, 2, 3), ``radii`` (n,), hand frame) and of ``hand``'s palm, per pose (p, 3) with its height
     offset ``base`` (p,).
@@ -26,14 +26,20 @@ def map_clearances(heights, hand, poses, base, ends, radii, stop=None) -> np.nda
     ``stop`` (p,) float, optional: a pose's walk ends at the first gap found below its ``stop`` -- the pose is
     refused whatever the rest -- that body's gap kept (an upper bound of its least) and every body not yet
     walked +inf.
+
+    ``only_below`` (p,) float, optional: a pose's bodies skip every cell that cannot bring their gap below it, so a
+    gap is exact where it is below ``only_below`` and only known to be at least ``only_below`` elsewhere -- for a
+    yes/no question (the closing sweep's "below the map?"), where the cells under a body far above them cost a
+    comparison each instead of a capsule's geometry.
     """
     out = np.empty((len(poses), len(ends) + 1))
     stop = np.full(len(poses), -np.inf) if stop is None else np.ascontiguousarray(stop, dtype=float)
+    only_below = np.full(len(poses), np.inf) if only_below is None else np.ascontiguousarray(only_below, dtype=float)
     clearances(np.ascontiguousarray(heights.conservative(), dtype=float), np.asarray(heights.origin, dtype=float),
                float(heights.cell), np.asarray(heights.table_normal, dtype=float), np.ascontiguousarray(poses, dtype=float),
                np.ascontiguousarray(base, dtype=float), np.ascontiguousarray(ends, dtype=float),
                np.ascontiguousarray(radii, dtype=float), np.ascontiguousarray(hand.palm.points, dtype=float),
-               np.ascontiguousarray(hand.palm.plane, dtype=float), VERTICAL_AXIS, stop, out)
+               np.ascontiguousarray(hand.palm.plane, dtype=float), VERTICAL_AXIS, stop, only_below, out)
     return out
 
 
@@ -106,9 +112,10 @@ def _palm_gap(layer, origin, cell, normal, i, k, x, y, c, s, outline, plane, bas
 
 
 @njit(cache=True)
-def clearances(layer, origin, cell, normal, poses, base, ends, radii, palm, plane, vertical, stop, out):
+def clearances(layer, origin, cell, normal, poses, base, ends, radii, palm, plane, vertical, stop, only_below, out):
     """Fill out (p, n_capsules + 1): per pose the least gap of each capsule (ends (n, 2, 3), radii (n,)) and the palm
-    (its outline (k, 2) and underside plane (3,)); a pose's walk ends at a gap below its ``stop`` (p,)."""
+    (its outline (k, 2) and underside plane (3,)); a pose's walk ends at a gap below its ``stop`` (p,), and skips
+    the cells that cannot bring a gap below its ``only_below`` (p,)."""
     nx_, ny_, nz_ = normal[0], normal[1], normal[2]
     for p in range(poses.shape[0]):
         x, y, c, s = poses[p, 0], poses[p, 1], math.cos(poses[p, 2]), math.sin(poses[p, 2])
@@ -144,7 +151,7 @@ def clearances(layer, origin, cell, normal, poses, base, ends, radii, palm, plan
                 if least < stop[p]:
                     break
                 for k in range(c0, c1 + 1):
-                    if lowest - _cell(layer, i, k) >= least:
+                    if lowest - _cell(layer, i, k) >= min(least, only_below[p]):
                         continue
                     if capsule:
                         least = min(least, _gap(layer, origin, cell, normal, i, k, x, y, c, s, pts, r, base[p], vertical))

@@ -70,7 +70,7 @@ def _below_map(hand: Hand, heights: HeightMap, pose, base: float, reaches) -> np
     owner = np.repeat(checked, [len(e) for e in ends])
     radii = np.array([hand.chains[f].radius for f in owner], dtype=float)
     out = map_clearances(heights, hand, np.asarray(pose, dtype=float)[None], np.array([base], dtype=float),
-                         np.concatenate(ends), radii)
+                         np.concatenate(ends), radii, only_below=np.zeros(1))
     np.logical_or.at(below, owner, out[0, :-1] < 0.0)
     return below
 
