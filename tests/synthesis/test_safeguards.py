@@ -260,6 +260,20 @@ def test_centring_distance_is_measured_in_the_hand_frame():
     assert centring_distance(hand, poses[2:], c + [0.01 + 0.03, 0.04])[0] == pytest.approx(0.05)
 
 
+def test_centring_distance_on_a_grid_takes_each_yaw_once_and_gives_the_same():
+    hand = cg.load_hand("five-finger-linear")
+    grid = cg.synthesis.SearchGrid(xy_step=0.02, yaw_step=math.radians(30))
+    poses = grid.poses(np.zeros(2))
+    locus = np.array([0.01, -0.02])
+    n_yaw = grid.shape[2]
+    np.testing.assert_allclose(centring_distance(hand, poses, locus, n_yaw=n_yaw),
+                               centring_distance(hand, poses, locus), rtol=0, atol=1e-15)
+    # the hand turned 90 deg puts its pinch centre (cx, cy) at (-cy, cx) from its origin, on the grid too
+    turned = (poses[:, 2] == poses[3, 2]) & np.all(poses[:, :2] == 0, axis=1)
+    c = hand.pinch_centre
+    assert centring_distance(hand, poses, [-c[1], c[0]], n_yaw=n_yaw)[turned] == pytest.approx(0.0, abs=1e-12)
+
+
 def test_the_centring_gain_adds_its_cost_and_brings_the_object_to_the_pinch_centre():
     contour, hand = cg.example_contour("bottle"), cg.load_hand("five-finger-linear")
     plain = cg.synthesize(contour, hand, **FAST)

@@ -84,8 +84,11 @@ def distance(p_virt, p_grasp):
     return float(np.linalg.norm(gap)) if gap.ndim == 1 else np.linalg.norm(gap, axis=-1)
 
 
-def centring_distance(hand: Hand, poses, locus) -> np.ndarray:
+def centring_distance(hand: Hand, poses, locus, *, n_yaw: int | None = None) -> np.ndarray:
     """(p,) float: distance from ``hand.pinch_centre`` to the object's centre ``locus``, in the hand frame, m.
+
+    It is the distance in the image plane from ``locus`` to the pinch centre placed by the pose, so
+    for a grid, whose yaws repeat, the placed centre's offset is computed once per yaw.
 
     Parameters
     ----------
@@ -94,6 +97,8 @@ def centring_distance(hand: Hand, poses, locus) -> np.ndarray:
         (x, y, yaw) of the hand in the image plane.
     locus : (2,) float
         The object's centre in the image plane, m.
+    n_yaw : int, optional
+        The period of the poses' yaws, as for :func:`score` (p a multiple of it); None for any list of poses.
 
     Examples
     --------
@@ -104,10 +109,12 @@ def centring_distance(hand: Hand, poses, locus) -> np.ndarray:
     0.0
     """
     poses = np.asarray(poses, dtype=float)
-    rx, ry = locus[0] - poses[:, 0], locus[1] - poses[:, 1]
-    c, s = np.cos(poses[:, 2]), np.sin(poses[:, 2])
+    period = len(poses) if n_yaw is None or len(poses) % n_yaw else n_yaw
+    c, s = np.cos(poses[:period, 2]), np.sin(poses[:period, 2])
     cx, cy = hand.pinch_centre
-    return np.hypot(c * rx + s * ry - cx, c * ry - s * rx - cy)  # R(yaw)^T (locus - xy), less the pinch centre
+    gap_x = (locus[0] - poses[:, 0]).reshape(-1, period) - (c * cx - s * cy)  # locus - (xy + R(yaw) pinch centre)
+    gap_y = (locus[1] - poses[:, 1]).reshape(-1, period) - (s * cx + c * cy)
+    return np.hypot(gap_x, gap_y).reshape(-1)
 
 
 def score(hand: Hand, poses, touching, lam, t, point, curv, start_inside, d_min, clear, epsilon,
@@ -164,7 +171,8 @@ def score(hand: Hand, poses, touching, lam, t, point, curv, start_inside, d_min,
     cost_quality = -safeguards.quality_gain * np.nan_to_num(epsilon) if safeguards.quality_gain else np.zeros(len(poses))
     cost_centring = np.zeros(len(poses))
     if safeguards.centring_gain and locus is not None:
-        cost_centring = safeguards.centring_gain * centring_distance(hand, poses, locus) ** 2 / tol.CENTRING_SCALE ** 2
+        cost_centring = (safeguards.centring_gain * centring_distance(hand, poses, locus, n_yaw=n_yaw) ** 2
+                         / tol.CENTRING_SCALE ** 2)
     return PoseEvaluation(
         poses=poses,
         touching=touching,
