@@ -10,8 +10,9 @@ from contourgrasp import load_hand
 from contourgrasp.errors import HandError, NoFeasibleGrasp, PerceptionError, PlannerError
 from contourgrasp.hand import Hand, SampledChain, chain_joints, chain_tip
 from contourgrasp.perception import HeightMap
-from contourgrasp.synthesis.descent import (Descent, body_names, check_candidates, descent_clearance, descent_feasible,
-                                            descent_floor, height_base)
+from contourgrasp.synthesis._descent_kernels import map_clearances
+from contourgrasp.synthesis.descent import (Descent, _open_hand, body_names, check_candidates, descent_clearance,
+                                            descent_feasible, descent_floor, height_base)
 
 CELL = 0.002
 CAMERA = 0.7  # camera height above the table: a point at planning depth z is 0.7 - z above it
@@ -348,9 +349,6 @@ def test_a_low_ring_the_closing_fingers_would_cross_blocks_every_pose_and_says_s
 
 def test_a_yes_no_walk_is_exact_below_its_threshold_and_no_lower_above_it(hand):
     """``only_below`` skips cells that cannot bring a gap below it: the closing sweep's speed-up changes no answer."""
-    from contourgrasp.synthesis._descent_kernels import map_clearances
-    from contourgrasp.synthesis.descent import _open_hand
-
     rng = np.random.default_rng(5)
     bumps = np.c_[rng.uniform(-0.06, 0.06, (6, 2)), rng.uniform(0.0, 0.12, 6)]
     heights = scene(lambda x, y: sum(np.where(np.hypot(x - a, y - b) < 0.02, h, 0.0) for a, b, h in bumps))

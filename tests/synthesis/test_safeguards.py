@@ -268,8 +268,10 @@ def test_centring_distance_on_a_grid_takes_each_yaw_once_and_gives_the_same():
     n_yaw = grid.shape[2]
     np.testing.assert_allclose(centring_distance(hand, poses, locus, n_yaw=n_yaw),
                                centring_distance(hand, poses, locus), rtol=0, atol=1e-15)
+    assert centring_distance(hand, poses[:0], locus, n_yaw=n_yaw).shape == (0,)
     # the hand turned 90 deg puts its pinch centre (cx, cy) at (-cy, cx) from its origin, on the grid too
     turned = (poses[:, 2] == poses[3, 2]) & np.all(poses[:, :2] == 0, axis=1)
+    assert poses[3, 2] == pytest.approx(math.pi / 2) and turned.sum() == 1
     c = hand.pinch_centre
     assert centring_distance(hand, poses, [-c[1], c[0]], n_yaw=n_yaw)[turned] == pytest.approx(0.0, abs=1e-12)
 

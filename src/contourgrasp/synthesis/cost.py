@@ -109,7 +109,7 @@ def centring_distance(hand: Hand, poses, locus, *, n_yaw: int | None = None) -> 
     0.0
     """
     poses = np.asarray(poses, dtype=float)
-    period = len(poses) if n_yaw is None or len(poses) % n_yaw else n_yaw
+    period = n_yaw if n_yaw and len(poses) >= n_yaw and len(poses) % n_yaw == 0 else max(len(poses), 1)
     c, s = np.cos(poses[:period, 2]), np.sin(poses[:period, 2])
     cx, cy = hand.pinch_centre
     gap_x = (locus[0] - poses[:, 0]).reshape(-1, period) - (c * cx - s * cy)  # locus - (xy + R(yaw) pinch centre)
