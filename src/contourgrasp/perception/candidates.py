@@ -471,11 +471,11 @@ def low_part_candidate(candidates, pixel, pixel_heights, *, min_height: float = 
     True
     """
     u, v = pixel
-    h = np.asarray(pixel_heights, dtype=np.float32)
+    h = np.asarray(pixel_heights)
     box = np.s_[max(v - LOW_PART_REACH_PX, 0):min(v + LOW_PART_REACH_PX + 1, h.shape[0]),
                 max(u - LOW_PART_REACH_PX, 0):min(u + LOW_PART_REACH_PX + 1, h.shape[1])]
     at = (v - box[0].start, u - box[1].start)
-    window = np.nan_to_num(h[box], nan=0.0, posinf=0.0, neginf=0.0)
+    window = np.nan_to_num(h[box].astype(np.float32), nan=0.0, posinf=0.0, neginf=0.0)  # the window only
     # raised as find_candidates has it (opened 3 x 3); a speck inside a bin's filled ring is not the ring's
     raised = open_specks(window > min_height)
     standing = _standing(raised, min_area_px)
