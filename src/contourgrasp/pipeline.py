@@ -35,6 +35,7 @@ from .perception.camera import check_intrinsics
 from .synthesis import Descent, GraspPlan, search
 from .synthesis.grasp_height import check_rule as check_grasp_height
 from .synthesis.grasp_height import grasp_height as choose_grasp_height
+from . import tolerances as tol
 from .tolerances import APPROACH_OFFSET, HOMOGENEOUS_ROW, MAX_APPROACH_OFFSET, MAX_STANDOFF, ROTATION_TOLERANCE
 
 SEGMENT_CHOICES = perception.SEGMENT_METHODS
@@ -122,6 +123,7 @@ def plan_frame(
     slice_contour: bool | str = False,
     closing_sweep: bool = False,
     closing_obstacles: bool = False,
+    low_objects: bool = False,
     **synthesis_options,
 ) -> ImageGraspPlan:
     """Plan a grasp on one RGB-D frame with a :class:`~contourgrasp.hand.Hand`.
@@ -234,6 +236,9 @@ def plan_frame(
     sweep = validation.flag("closing_sweep", closing_sweep, error=PlannerError)
     closing = validation.flag("closing_obstacles", closing_obstacles, error=PlannerError)
     spec = Descent(heights, *asked, sweep=sweep, closing=closing) if descent and asked is not None else None
+    low = validation.flag("low_objects", low_objects, error=PlannerError)
+    if low and heights is not None and heights.max_height < tol.LOW_OBJECT_HEIGHT:
+        synthesis_options = {**synthesis_options, "low_object": True}
     slicing = bool(slice_contour) if isinstance(slice_contour, np.bool_) else slice_contour  # as flag() took them
     slicing = validation.choice("slice_contour", slicing, SLICE_CONTOUR, error=PlannerError)
     section = perception.cross_section(heights, asked[0]) if slicing is True and asked is not None else None

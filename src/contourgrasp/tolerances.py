@@ -434,6 +434,9 @@ HAND_MAX_IMBALANCE = 0.25
 #: three, the strawberry still had no plan.
 SMALL_OBJECT_TOUCHING = 2
 
+import os as _os
+LOW_OBJECT_HEIGHT = float(_os.environ.get('CG_LOW', '0.03'))
+
 #: Chords per quarter circle of the arcs contour.grow_polygon puts at convex corners (shapely's quad_segs): a 9 mm
 #: fingertip's arc deviates from its chords by 9 mm x (1 - cos(pi / 32)) = 0.04 mm.
 GROWTH_ARC_SEGMENTS = 8

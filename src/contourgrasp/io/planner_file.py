@@ -58,7 +58,7 @@ _PRESET_DIR = "data/planners"
 #: Options that belong to perception, and to planning in the scene's 3-D (the rest are
 #: :func:`contourgrasp.synthesis.search`'s).
 PERCEPTION_OPTIONS = ("depth_mode", "footprint")
-SCENE_OPTIONS = ("descent", "grasp_height", "slice_contour", "closing_sweep", "closing_obstacles")
+SCENE_OPTIONS = ("descent", "grasp_height", "slice_contour", "closing_sweep", "closing_obstacles", "low_objects")
 
 Positive = Annotated[float, Field(gt=0, le=tol.MAX_SEARCH_LENGTH, allow_inf_nan=False)]
 Distance = Annotated[float, Field(ge=0, le=tol.MAX_SEARCH_LENGTH, allow_inf_nan=False)]
@@ -91,6 +91,7 @@ class _PlannerSchema(BaseModel):
     closing_sweep: bool | None = None
     closing_obstacles: bool | None = None
     small_objects: bool | None = None
+    low_objects: bool | None = None
     grasp_height: (Literal["clearance", "auto"]
                    | Annotated[float, Field(ge=0, le=tol.MAX_HAND_SIZE, allow_inf_nan=False)] | None) = None
 

@@ -366,6 +366,12 @@ def height_map(
     with np.errstate(invalid="ignore"):
         raised = seen & (grid >= MIN_HEIGHT)
     obj |= raised & dilate(obj, int(math.ceil(HEIGHT_MAP_OBJECT_BAND / cell - 1e-9)))
+    import os as _os
+    if _os.environ.get('CG_TABLE'):
+        band = float(_os.environ['CG_TABLE'])
+        with np.errstate(invalid="ignore"):
+            table = seen & ~obj & (grid < band)
+        grid = np.where(table, np.minimum(grid, 0.0), grid)
 
     table_normal = R.T @ plane.normal
     table_offset = float(plane.normal @ o + plane.offset)

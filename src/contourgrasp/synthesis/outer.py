@@ -68,6 +68,7 @@ def search(
     balance_required: bool = False,
     balanced_alternative: Callable[[], GraspPlan] | None = None,
     small_objects: bool = False,
+    low_object: bool = False,
     descent: Descent | None = None,
 ) -> GraspPlan:
     """Plan a grasp on a contour: fit the EFD model, search the pose grid, return the best pose.
@@ -188,6 +189,17 @@ def search(
     outline = partial(_search_outline, hand=hand, grid=grid, safeguards=safeguards, descent=descent,
                       harmonics=harmonics, curvature=curvature, small_objects=small_objects, top_k=top_k,
                       refine=refine, clock=clock, fallback=preferred, alternative=elsewhere)
+    low_object = check.flag("low_object", low_object, error=PlannerError)
+    radius = min(f.radius for f in hand.fingers)
+    if low_object and small_objects and radius > 0:
+        fewest = max(tol.SMALL_OBJECT_TOUCHING, sum(f.required for f in hand.fingers))
+        grown = efd_model.clean_polygon(efd_model.grow_polygon(contour, radius), check_units=False)
+        try:
+            plan = outline(grown, hand=replace(hand, min_touching=min(fewest, hand.min_touching), miss_penalty=0.0))
+            note = NOTE_LOW.format(radius=1000 * radius)
+            return replace(plan, contour=contour, grown=radius, search_notes=plan.search_notes + (note,))
+        except NoFeasibleGrasp:
+            pass
     try:
         return outline(contour)
     except _OutOfReach as points:
@@ -287,6 +299,11 @@ class _OutOfReach(NoFeasibleGrasp):
 NOTE_BALLS = ("no pose brings the fingertips, as points, onto the object within their travel: planned on its "
               "outline grown by {radius:.1f} mm, the fingers' smallest radius (grasp points are the tips' centres "
               "when their balls first touch it)")
+
+
+#: The note of a plan made by the low-object rule.
+NOTE_LOW = ("a low object: planned with the fingertips as balls (its outline grown by {radius:.1f} mm, the fingers' "
+            "smallest radius) and the thumb against one finger")
 
 
 #: The note of a plan whose squeeze no pose could balance within ``max_imbalance``.
