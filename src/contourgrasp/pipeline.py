@@ -199,6 +199,10 @@ def plan_frame(
     closing_sweep : bool
         With ``descent``: also refuse a pose where a touching finger's chain would meet the scene
         before its tip reaches its grasp point (:mod:`contourgrasp.synthesis.sweep`).
+    low_objects : bool
+        Plan an object lower than ``tolerances.LOW_OBJECT_HEIGHT`` (its height map's ``max_height``) first as a
+        pinch of the thumb against one finger with the fingertips as balls (:func:`~contourgrasp.synthesis.search`'s
+        ``low_object``); needs a table (the height map).
     closing_obstacles : bool
         With ``descent``: also refuse a pose where a finger, closing until it meets the target (or to
         its end, if it misses), would run into a neighbouring object or a bin's wall -- the height
@@ -236,9 +240,8 @@ def plan_frame(
     sweep = validation.flag("closing_sweep", closing_sweep, error=PlannerError)
     closing = validation.flag("closing_obstacles", closing_obstacles, error=PlannerError)
     spec = Descent(heights, *asked, sweep=sweep, closing=closing) if descent and asked is not None else None
-    low = validation.flag("low_objects", low_objects, error=PlannerError)
-    if low and heights is not None and heights.max_height < tol.LOW_OBJECT_HEIGHT:
-        synthesis_options = {**synthesis_options, "low_object": True}
+    if validation.flag("low_objects", low_objects, error=PlannerError) and heights is not None:
+        synthesis_options = {**synthesis_options, "low_object": bool(heights.max_height < tol.LOW_OBJECT_HEIGHT)}
     slicing = bool(slice_contour) if isinstance(slice_contour, np.bool_) else slice_contour  # as flag() took them
     slicing = validation.choice("slice_contour", slicing, SLICE_CONTOUR, error=PlannerError)
     section = perception.cross_section(heights, asked[0]) if slicing is True and asked is not None else None

@@ -34,6 +34,7 @@ which is the thesis's setting)::
     closing_sweep = false        # refuse poses where a finger's link meets the object before its tip (synthesis.sweep)
     closing_obstacles = false    # refuse poses where a closing finger runs into a neighbour or a bin wall
     small_objects = false        # fewer touching fingers where no pose satisfies the constraints (synthesis.search)
+    low_objects = false          # an object lower than tolerances.LOW_OBJECT_HEIGHT planned first as a pinch (plan_frame)
 
 Unknown keys, wrong types and impossible values are refused with
 :class:`PlannerFileError` naming the file and the field; so is a file that is not UTF-8 text or

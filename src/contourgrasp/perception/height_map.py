@@ -27,6 +27,17 @@ the table (a depth reading half-way between the two), which errs toward caution.
 biases it up, by the largest of a cell's few noisy readings; ``max_height`` avoids that bias (see
 :class:`HeightMap`).
 
+The table at its plane
+----------------------
+A seen cell that is neither the object's nor an obstacle (standing less than ``MIN_HEIGHT`` above the
+table) is the table itself and reads at most 0. The support plane is fitted to thousands of points
+and known to about a millimetre, while a table cell's highest reading is its noise's extreme (on
+the simulated frames the table cells' 90th percentile is 2.9 mm and their 99th 4.6 mm): kept, it
+held the descent check's open hand that much above the table it asked for, and a fingertip meant
+to pass just above the table passed 2-4 mm higher, over the edge of a flat object it was to close
+on. The segmentation calls nothing lower than ``MIN_HEIGHT`` raised either; readings below the
+plane keep their height.
+
 Unseen cells
 ------------
 A cell that no valid reading falls in is NaN, not 0: it is unknown, not table. Single empty cells
@@ -83,7 +94,8 @@ class HeightMap:
     ----------
     heights : (ny, nx) float
         Height above the table of the highest point seen in each cell's column, m; NaN where
-        unseen (see the module's docstring, and :meth:`conservative`).
+        unseen (see the module's docstring, and :meth:`conservative`); at most 0 on the table's own
+        cells (neither ``object`` nor ``obstacles``: the module's docstring, "The table at its plane").
     cell : float
         Side of a cell, m.
     origin : (2,) float
@@ -366,12 +378,7 @@ def height_map(
     with np.errstate(invalid="ignore"):
         raised = seen & (grid >= MIN_HEIGHT)
     obj |= raised & dilate(obj, int(math.ceil(HEIGHT_MAP_OBJECT_BAND / cell - 1e-9)))
-    import os as _os
-    if _os.environ.get('CG_TABLE'):
-        band = float(_os.environ['CG_TABLE'])
-        with np.errstate(invalid="ignore"):
-            table = seen & ~obj & (grid < band)
-        grid = np.where(table, np.minimum(grid, 0.0), grid)
+    grid = np.where(seen & ~raised & ~obj, np.minimum(grid, 0.0), grid)  # the table at its plane (module docstring)
 
     table_normal = R.T @ plane.normal
     table_offset = float(plane.normal @ o + plane.offset)

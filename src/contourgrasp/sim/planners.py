@@ -55,7 +55,8 @@ from ..io.planner_file import Planner, load_planner, planner_names
 #: the 3-D hand's steps (issue 16): finger bodies against the height map (with the executor's old grasp height),
 #: the planned grasp height, the closing sweep, the small-object rule; the closing fingers kept clear of
 #: obstacles (issue 17); the squeeze's balance; then the cross-section at the grasp height (in ``default``
-#: only where the outline seen has no balanced squeeze); last, the object between thumb and index.
+#: only where the outline seen has no balanced squeeze); the object between thumb and index; last, the
+#: low-object rule.
 ABLATION_STEPS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("grid", ("xy_step", "yaw_step", "d_max", "d_min")),
     ("quality", ("friction", "require_closure", "quality_gain")),
@@ -70,6 +71,7 @@ ABLATION_STEPS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("balance", ("max_imbalance",)),
     ("slice", ("slice_contour",)),
     ("centring", ("centring_gain",)),
+    ("low", ("low_objects",)),
 )
 #: Baseline planners without synthesis: name -> what it does (module docstring).
 BASELINES = {

@@ -133,6 +133,15 @@ def search(
         thesis's point fingertips cannot close on an object smaller than the gap their travels
         leave (35 mm between the five-finger hand's thumb and index); the balls of a real hand do.
         The plan's ``grown`` says so, and its notes.
+    low_object : bool
+        The low-object rule (the caller judges the object low: :func:`contourgrasp.pipeline.plan_frame`'s
+        ``low_objects``). First plan a pinch: the thumb against one finger (``tolerances.SMALL_OBJECT_TOUCHING``
+        touching, or the hand's required fingers), the fingertips as balls (the outline grown by the
+        smallest finger ``radius``, as above), and no ``miss_penalty`` for the fingers that close on air,
+        which would otherwise prefer poses where they touch too; only where no such pose is feasible,
+        the search as without it. Our reading of why: a one-DoF hand lifts a flat object lying on the table
+        between thumb and index, the balls' sides meeting its edges, while the other fingers, arriving on
+        it first or pressing on its top, push it away (README, "The 3-D hand in the plan").
     descent : Descent, optional
         The scene's height map and the grasp height: a pose is feasible only if the open hand,
         lowered along the approach axis until its lowest fingertip is at ``descent.tip_height``,
@@ -189,17 +198,8 @@ def search(
     outline = partial(_search_outline, hand=hand, grid=grid, safeguards=safeguards, descent=descent,
                       harmonics=harmonics, curvature=curvature, small_objects=small_objects, top_k=top_k,
                       refine=refine, clock=clock, fallback=preferred, alternative=elsewhere)
-    low_object = check.flag("low_object", low_object, error=PlannerError)
-    radius = min(f.radius for f in hand.fingers)
-    if low_object and small_objects and radius > 0:
-        fewest = max(tol.SMALL_OBJECT_TOUCHING, sum(f.required for f in hand.fingers))
-        grown = efd_model.clean_polygon(efd_model.grow_polygon(contour, radius), check_units=False)
-        try:
-            plan = outline(grown, hand=replace(hand, min_touching=min(fewest, hand.min_touching), miss_penalty=0.0))
-            note = NOTE_LOW.format(radius=1000 * radius)
-            return replace(plan, contour=contour, grown=radius, search_notes=plan.search_notes + (note,))
-        except NoFeasibleGrasp:
-            pass
+    if check.flag("low_object", low_object, error=PlannerError) and (plan := _as_pinch(contour, hand, outline)):
+        return plan
     try:
         return outline(contour)
     except _OutOfReach as points:
@@ -267,6 +267,22 @@ def _search_outline(contour, *, hand: Hand, grid: SearchGrid, safeguards: Safegu
     raise NoFeasibleGrasp(reason)
 
 
+def _as_pinch(contour, hand: Hand, outline: Callable[..., GraspPlan]) -> GraspPlan | None:
+    """The low-object rule's plan: ``outline`` (:func:`_search_outline`, bound) on the contour grown by the fingers'
+    smallest radius, with the thumb against one finger and no penalty for the fingers that miss; None without one."""
+    radius = min(f.radius for f in hand.fingers)
+    if radius <= 0:
+        return None
+    pinch = min(hand.min_touching, max(tol.SMALL_OBJECT_TOUCHING, sum(f.required for f in hand.fingers)))
+    grown = efd_model.clean_polygon(efd_model.grow_polygon(contour, radius), check_units=False)
+    try:
+        plan = outline(grown, hand=replace(hand, min_touching=pinch, miss_penalty=0.0))
+    except NoFeasibleGrasp:
+        return None
+    note = NOTE_LOW.format(radius=1000 * radius)
+    return replace(plan, contour=contour, grown=radius, search_notes=plan.search_notes + (note,))
+
+
 class _Elsewhere:
     """A :func:`search`'s ``balanced_alternative``, called at most once; ``plan`` is what it returned, if any."""
 
@@ -302,8 +318,8 @@ NOTE_BALLS = ("no pose brings the fingertips, as points, onto the object within 
 
 
 #: The note of a plan made by the low-object rule.
-NOTE_LOW = ("a low object: planned with the fingertips as balls (its outline grown by {radius:.1f} mm, the fingers' "
-            "smallest radius) and the thumb against one finger")
+NOTE_LOW = ("a low object: planned as a pinch, the thumb against one finger, with the fingertips as balls (the "
+            "outline grown by {radius:.1f} mm, the fingers' smallest radius)")
 
 
 #: The note of a plan whose squeeze no pose could balance within ``max_imbalance``.
