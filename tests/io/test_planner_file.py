@@ -51,6 +51,7 @@ def test_a_file_round_trips_its_options(tmp_path):
     ('name = "x"\nslice_contour = "sometimes"', 'slice_contour: must be true, false or "unbalanced", got \'sometimes\''),
     ('name = "x"\nslice_contour = 1', 'slice_contour: must be true, false or "unbalanced", got 1'),
     ('name = "x"\nsmall_objects = "yes"', "small_objects"),
+    ('name = "x"\nlow_objects = 1', "low_objects"),
     ('name = "x"\nmax_imbalance = "hands"', "max_imbalance"),
     ('name = "x"\nmax_imbalance = 1.5', "max_imbalance"),
 ])

@@ -185,3 +185,27 @@ def perception_depth(depth):
     from contourgrasp.perception import fill_depth_holes
 
     return fill_depth_holes(depth)[0]
+
+
+def test_the_tables_own_cells_read_its_plane_not_their_noise():
+    # Noise of +-4 mm on every reading: a table cell keeps its highest reading unless it is the table's own cell.
+    depth, table, seg, metric, _ = scene(height=0.05)
+    noisy = depth + np.random.default_rng(0).uniform(-0.004, 0.004, depth.shape)
+    hm = height_map(noisy, CAMERA, table, metric, seg.mask, margin=0.12)
+    own = hm.seen & ~hm.object & ~hm.obstacles
+    assert own.sum() > 1000 and np.nanmax(hm.heights[own]) <= 0.0
+    assert np.nanmin(hm.heights[own]) < -0.002  # readings below the plane keep their height
+    x, y = cell_xy(hm)
+    top = (np.abs(x - 0.02) < 0.02) & (np.abs(y + 0.03) < 0.02)
+    assert hm.heights[top].min() > 0.045 and hm.heights[top].max() > 0.0505  # the object's cells keep their highest
+
+
+def test_a_neighbour_keeps_its_height_and_a_sheet_lower_than_min_height_is_table():
+    depth, table, seg, metric, _ = scene(height=0.05, centre=(0.02, -0.03))
+    neighbour, _, _, _ = render(kind="box", radius=0.015, height=0.03, centre=(-0.08, 0.05))
+    sheet, _, _, _ = render(kind="box", radius=0.015, height=0.006, centre=(0.09, 0.06))
+    both = np.minimum(np.minimum(depth, neighbour), sheet)
+    hm = height_map(both, CAMERA, table, metric, seg.mask, margin=0.12)
+    np.testing.assert_allclose(hm.at([[-0.08, 0.05]]), 0.03, atol=1e-3)
+    assert hm.obstacles[hm.cell_index([[-0.08, 0.05]])[:2]].all()
+    assert hm.at([[0.09, 0.06]])[0] == 0.0  # 6 mm: below the segmentation's MIN_HEIGHT, read as the table

@@ -1,6 +1,7 @@
 """The search (synthesis.outer): plans on the examples, invariances, options, infeasibility."""
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -234,6 +235,33 @@ def test_the_small_object_rule_plans_fewer_touching_fingers_and_says_why_when_it
     assert plan.hand.min_touching == 2 and sum(not f.missed for f in plan.fingers) == 2
     with pytest.raises(cg.NoFeasibleGrasp, match="with the small-object rule, down to 2 touching fingers: no pose"):
         cg.synthesize(disc / 7, "five-finger-linear", small_objects=True, **grid)
+
+
+def test_the_low_object_rule_pinches_with_the_thumb_and_the_fingertips_balls_on_the_grown_outline():
+    circle = disc(0.04)  # 8 cm across: the fingers reach it as points
+    hand = cg.load_hand("five-finger-linear")
+    grid = {"yaw_step": math.radians(10), "xy_step": 0.01}
+    points = cg.synthesize(circle, hand, **grid)
+    assert points.grown == 0.0 and points.hand.min_touching == 4
+    pinch = cg.synthesize(circle, hand, low_object=True, **grid)
+    radius = min(f.radius for f in hand.fingers)
+    assert pinch.grown == radius and "a low object" in pinch.notes[-1]
+    assert pinch.hand.min_touching == 2 and pinch.hand.miss_penalty == 0.0
+    touching = [f for f in pinch.fingers if not f.missed]
+    assert "thumb" in [f.name for f in touching] and len(touching) >= 2
+    # a ball touches the disc where its centre meets the disc grown by its radius: 49 mm from the centre
+    np.testing.assert_allclose([np.linalg.norm(f.grasp_point) for f in touching], 0.04 + radius, atol=2e-4)
+    np.testing.assert_array_equal(pinch.contour, points.contour)  # the plan keeps the outline seen
+
+
+def test_the_low_object_rule_needs_fingertips_with_a_radius_and_a_flag():
+    circle = disc(0.04)
+    hand = cg.load_hand("five-finger-linear")
+    points = replace(hand, fingers=tuple(replace(f, radius=0.0) for f in hand.fingers), chains=None, palm=None)
+    plan = cg.synthesize(circle, points, low_object=True, yaw_step=math.radians(10), xy_step=0.01)
+    assert plan.grown == 0.0 and plan.hand.min_touching == 4
+    with pytest.raises(cg.PlannerError, match="low_object"):
+        cg.synthesize(circle, hand, low_object="yes")
 
 
 def test_an_attempts_reason_is_worked_out_once_and_only_when_asked():

@@ -193,6 +193,9 @@ def test_a_plan_made_elsewhere_is_not_labelled_as_the_grown_outline_s():
     plan = cg.synthesize(disc, hand, small_objects=True, max_imbalance=0.01, balanced_alternative=lambda: elsewhere,
                          **options)
     assert plan is elsewhere and plan.grown == 0.0  # asked for on the grown outline, returned as it came
+    pinch = cg.synthesize(disc * 4, hand, low_object=True, max_imbalance=0.01, balanced_alternative=lambda: elsewhere,
+                          **options)
+    assert pinch is elsewhere  # the low-object rule's pinch, unbalanced, turned to it: not labelled a pinch
 
 
 def test_the_alternative_waits_while_the_fingers_cannot_reach_the_object_as_points():

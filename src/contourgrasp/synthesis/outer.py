@@ -198,25 +198,43 @@ def search(
     outline = partial(_search_outline, hand=hand, grid=grid, safeguards=safeguards, descent=descent,
                       harmonics=harmonics, curvature=curvature, small_objects=small_objects, top_k=top_k,
                       refine=refine, clock=clock, fallback=preferred, alternative=elsewhere)
-    if check.flag("low_object", low_object, error=PlannerError) and (plan := _as_pinch(contour, hand, outline)):
-        return plan
+    radius = min(f.radius for f in hand.fingers)
+    if check.flag("low_object", low_object, error=PlannerError) and radius > 0:
+        pinch = replace(hand, min_touching=_fewest_touching(hand), miss_penalty=0.0)
+        try:
+            plan = outline(_grown(contour, radius), hand=pinch)
+            return plan if plan is elsewhere.plan else _as_balls(plan, contour, radius, NOTE_LOW)
+        except NoFeasibleGrasp:
+            pass
     try:
         return outline(contour)
     except _OutOfReach as points:
-        radius = min(f.radius for f in hand.fingers)
         if not small_objects or radius <= 0:
             raise NoFeasibleGrasp(points.reason) from None
         try:
-            # the one gate every outline passes before its fit: growth can triple a jagged outline's vertices
-            plan = outline(efd_model.clean_polygon(efd_model.grow_polygon(contour, radius), check_units=False))
+            plan = outline(_grown(contour, radius))
         except NoFeasibleGrasp as balls:
             why = balls.fewest if isinstance(balls, _OutOfReach) else balls.reason
             raise NoFeasibleGrasp(f"{points.reason}; with the fingertips as balls (the outline grown by "
                                   f"{1000 * radius:.1f} mm): {why}") from None
-    if plan is elsewhere.plan:  # planned elsewhere, not on the grown outline
-        return plan
-    note = NOTE_BALLS.format(radius=1000 * radius)
-    return replace(plan, contour=contour, grown=radius, search_notes=plan.search_notes + (note,))
+    return plan if plan is elsewhere.plan else _as_balls(plan, contour, radius, NOTE_BALLS)
+
+
+def _grown(contour, radius: float) -> np.ndarray:
+    """The outline a fingertip ball's centre meets: ``contour`` grown by ``radius``, cleaned (the one gate every
+    outline passes before its fit: growth can triple a jagged outline's vertices)."""
+    return efd_model.clean_polygon(efd_model.grow_polygon(contour, radius), check_units=False)
+
+
+def _as_balls(plan: GraspPlan, contour, radius: float, note: str) -> GraspPlan:
+    """A plan made on the outline grown by ``radius``, reported on the outline seen, with its ``note``."""
+    notes = plan.search_notes + (note.format(radius=1000 * radius),)
+    return replace(plan, contour=contour, grown=radius, search_notes=notes)
+
+
+def _fewest_touching(hand: Hand) -> int:
+    """The small-object rule's fewest touching fingers: the thumb against one (or the required fingers)."""
+    return min(hand.min_touching, max(tol.SMALL_OBJECT_TOUCHING, sum(f.required for f in hand.fingers)))
 
 
 def _search_outline(contour, *, hand: Hand, grid: SearchGrid, safeguards: Safeguards, descent: Descent | None,
@@ -230,8 +248,7 @@ def _search_outline(contour, *, hand: Hand, grid: SearchGrid, safeguards: Safegu
         harmonics = efd_model.choose_harmonics(contour, validate=False)
     model = efd_model.fit(contour, harmonics, validate=False)
     fitted = time.perf_counter()
-    fewest = max(tol.SMALL_OBJECT_TOUCHING, sum(f.required for f in hand.fingers))
-    fewest = min(fewest, hand.min_touching) if small_objects else hand.min_touching
+    fewest = _fewest_touching(hand) if small_objects else hand.min_touching
     counts = range(hand.min_touching, fewest - 1, -1)
     screen = screen_grid(model, replace(hand, min_touching=fewest), grid, curvature=curvature,
                          centring_gain=safeguards.centring_gain)
@@ -265,22 +282,6 @@ def _search_outline(contour, *, hand: Hand, grid: SearchGrid, safeguards: Safegu
     if isinstance(errors[len(counts) - 1], _OutOfReach):
         raise _OutOfReach(reason, fewest=str(errors[len(counts) - 1]))
     raise NoFeasibleGrasp(reason)
-
-
-def _as_pinch(contour, hand: Hand, outline: Callable[..., GraspPlan]) -> GraspPlan | None:
-    """The low-object rule's plan: ``outline`` (:func:`_search_outline`, bound) on the contour grown by the fingers'
-    smallest radius, with the thumb against one finger and no penalty for the fingers that miss; None without one."""
-    radius = min(f.radius for f in hand.fingers)
-    if radius <= 0:
-        return None
-    pinch = min(hand.min_touching, max(tol.SMALL_OBJECT_TOUCHING, sum(f.required for f in hand.fingers)))
-    grown = efd_model.clean_polygon(efd_model.grow_polygon(contour, radius), check_units=False)
-    try:
-        plan = outline(grown, hand=replace(hand, min_touching=pinch, miss_penalty=0.0))
-    except NoFeasibleGrasp:
-        return None
-    note = NOTE_LOW.format(radius=1000 * radius)
-    return replace(plan, contour=contour, grown=radius, search_notes=plan.search_notes + (note,))
 
 
 class _Elsewhere:
