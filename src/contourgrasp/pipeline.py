@@ -28,6 +28,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from . import perception, validation
+from . import tolerances as tol
 from .errors import HandError, NoFeasibleGrasp, PerceptionError, PlannerError, SegmentationError
 from .hand import Hand
 from .perception import HeightMap, Intrinsics, MetricContour, Plane, Segmentation
@@ -35,7 +36,6 @@ from .perception.camera import check_intrinsics
 from .synthesis import Descent, GraspPlan, search
 from .synthesis.grasp_height import check_rule as check_grasp_height
 from .synthesis.grasp_height import grasp_height as choose_grasp_height
-from . import tolerances as tol
 from .tolerances import APPROACH_OFFSET, HOMOGENEOUS_ROW, MAX_APPROACH_OFFSET, MAX_STANDOFF, ROTATION_TOLERANCE
 
 SEGMENT_CHOICES = perception.SEGMENT_METHODS
