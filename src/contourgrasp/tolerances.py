@@ -437,7 +437,8 @@ SMALL_OBJECT_TOUCHING = 2
 #: The low-object rule (pipeline.plan_frame(low_objects=True)): an object whose top (HeightMap.max_height) is lower
 #: than this (m) is planned first as a pinch with the fingertips as balls (synthesis.search(low_object=True)). Chosen
 #: on ycb-train, in the gap between its objects' heights: the rule lifted the medium clamp (27 mm) and the Lego brick
-#: (24 mm); the next, the gelatin box and the tuna can (32-35 mm), were lifted every time without it.
+#: (24 mm); the next, the gelatin box and the tuna can (32-35 mm), were lifted every time without it (at 36 mm
+#: ycb-train is the same, at 25 mm the clamp leaves the rule and two trials are lost: benchmarks/hand3d_sweep.md).
 LOW_OBJECT_HEIGHT = 0.03
 
 #: Chords per quarter circle of the arcs contour.grow_polygon puts at convex corners (shapely's quad_segs): a 9 mm
