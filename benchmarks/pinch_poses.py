@@ -44,6 +44,7 @@ from contourgrasp.sim import render, trial
 from contourgrasp.sim.ycb import load_object
 from contourgrasp.synthesis import evaluate_poses
 from contourgrasp.synthesis.grasp_height import open_floor
+from contourgrasp.synthesis.outer import _fewest_touching, _grown
 
 HAND = "five-finger-linear"
 
@@ -88,11 +89,10 @@ def models(name: str, seed: int, poses: np.ndarray):
     rgb, depth = render(scene, noise=True, seed=seed)
     frame = pipeline.plan_frame(rgb, depth, scene.camera.intrinsics, hand, **options)
     plan = frame.plan
-    grown = contour.clean_polygon(contour.grow_polygon(plan.contour, min(f.radius for f in hand.fingers)),
-                                  check_units=False)
+    grown = _grown(plan.contour, min(f.radius for f in hand.fingers))  # as the low-object rule grows it
     fitted = {"points": (plan.efd, hand),
               "pinch": (contour.fit(grown, options["harmonics"], validate=False),
-                        replace(hand, min_touching=2, miss_penalty=0.0))}
+                        replace(hand, min_touching=_fewest_touching(hand), miss_penalty=0.0))}
     return {label: evaluate_poses(model, model_hand, planning_frame_poses(frame.metric, poses),
                                   curvature=plan.curvature_mode, d_min=plan.grid.d_min, safeguards=plan.safeguards)
             for label, (model, model_hand) in fitted.items()}
