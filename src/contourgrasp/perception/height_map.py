@@ -32,7 +32,7 @@ The table at its plane
 A seen cell that is neither the object's nor an obstacle (standing less than ``MIN_HEIGHT`` above the
 table) is the table itself and reads at most 0. The support plane is fitted to thousands of points
 and known to about a millimetre, while a table cell's highest reading is its noise's extreme (on
-the simulated frames the table cells' 90th percentile is 2.9 mm and their 99th 4.6 mm): kept, it
+the Lego brick's simulated frame the table cells' 90th percentile is 2.9 mm and their 99th 4.6 mm): kept, it
 held the descent check's open hand that much above the table it asked for, and a fingertip meant
 to pass just above the table passed 2-4 mm higher, over the edge of a flat object it was to close
 on. The segmentation calls nothing lower than ``MIN_HEIGHT`` raised either; readings below the
