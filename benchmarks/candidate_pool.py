@@ -28,7 +28,7 @@ what a perfect choice among these candidates would reach.
 Usage::
 
     .venv/bin/python benchmarks/candidate_pool.py --objects thesis,ycb-train --seeds 0,1,2,3,4 [--workers 2]
-        [--json FILE]
+        [--hand-model inspire] [--json FILE]
 
 Prints a markdown table per object set given, then the whole: frames, the plan's successes, the pool's
 ceiling, per class how often its cheapest pose lifts (of the frames that have the class) and all of
@@ -46,7 +46,8 @@ from dataclasses import replace
 import mujoco
 import numpy as np
 
-from contourgrasp import load_hand, pipeline
+import pose_oracle
+from contourgrasp import pipeline
 from contourgrasp import tolerances as tol
 from contourgrasp.io.planner_file import load_planner
 from contourgrasp.sim import render, trial
@@ -63,12 +64,13 @@ STATE = mujoco.mjtState.mjSTATE_INTEGRATION
 UNBALANCED = 1.0 - 1e-9
 
 
-def frame(task: tuple[str, int, int, int]) -> list[dict]:
+def frame(task: tuple[str, int, int, int, str | None]) -> list[dict]:
     """The planned pose and the executed classes of one frame's pool, one record each."""
     warnings.simplefilter("ignore")
-    name, seed, screened, per_class = task
-    hand, options = load_hand(HAND), load_planner("default").plan_options
-    scene = trial.trial_scene(load_object(name), seed=seed)
+    name, seed, screened, per_class, hand_model = task
+    simulated, hand = pose_oracle._hand(HAND, hand_model)
+    options = load_planner("default").plan_options
+    scene = trial.trial_scene(load_object(name), seed=seed, hand=simulated)
     rgb, depth = render(scene, noise=True, seed=seed)
     state = np.empty(mujoco.mj_stateSize(scene.model, STATE))
     mujoco.mj_getState(scene.model, scene.data, state, STATE)
@@ -108,7 +110,7 @@ def _classes(planned, hand, options, screened: int, per_class: int) -> list[tupl
     exact = evaluate_poses(plan.efd, fewest, screen.poses[cheapest], curvature=plan.curvature_mode,
                            d_min=plan.grid.d_min, safeguards=guards)
     rows = np.flatnonzero(exact.feasible)
-    lowest, highest = pipeline._grasp_height(hand, heights, True, None)
+    lowest, highest = pipeline._grasp_height(hand, heights, options["descent"], options["grasp_height"])
     tips = np.full(len(exact.poses), np.inf)
     tips[rows] = _raised(descent_feasible(hand, heights, exact.poses[rows], lowest, margin=DESCENT_MARGIN))
     descends = tips <= highest
@@ -179,12 +181,15 @@ def main() -> None:
     parser.add_argument("--seeds", default="0,1,2,3,4", help="comma-separated scene seeds (the bench's trial t: seed t)")
     parser.add_argument("--screened", type=int, default=1500, help="cheapest screened poses evaluated exactly")
     parser.add_argument("--per-class", type=int, default=3, help="distinct poses executed per class")
+    parser.add_argument("--hand-model", default=None, help="a bundled model (inspire, jaco-three-finger), "
+                        "simulated as itself and planned with its derived hand file, as the bench's --hand-model")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--json", default=None, help="write every executed pose's record here")
     args = parser.parse_args()
     sets = {part: object_names(part) for part in args.objects.split(",")}
     seeds = [int(s) for s in args.seeds.split(",")]
-    tasks = [(name, seed, args.screened, args.per_class) for names in sets.values() for name in names for seed in seeds]
+    tasks = [(name, seed, args.screened, args.per_class, args.hand_model)
+             for names in sets.values() for name in names for seed in seeds]
     started = time.perf_counter()
     with multiprocessing.get_context("spawn").Pool(args.workers) as pool:
         records = [r for rows in pool.imap(frame, tasks) for r in rows]
