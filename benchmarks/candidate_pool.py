@@ -80,10 +80,14 @@ def frame(task: tuple[str, int, int, int, str | None]) -> list[dict]:
     except Exception as err:  # noqa: BLE001 -- a frame without a plan is reported, not fatal
         return [base | {"class": "no plan", "success": False, "cause": str(err).splitlines()[0][:200]}]
     plan, heights = planned.plan, planned.height_map
-    executed = [(plan.pose, planned.grasp_height, "planned", {})] + _classes(planned, hand, options, screened,
-                                                                         per_class)
+    fewest, guards = _pool_search(plan, hand, options)
+    executed = [(plan.pose, planned.grasp_height, "planned")] + _classes(planned, hand, options, screened, per_class)
+    exact = evaluate_poses(plan.efd, fewest, np.array([pose for pose, _, _ in executed]),
+                           curvature=plan.curvature_mode, d_min=plan.grid.d_min, safeguards=guards)
     records = []
-    for pose, tip, label, features in executed:
+    for k, (pose, tip, label) in enumerate(executed):
+        features = {"cost": float(exact.cost[k]), "curvature_cost": float(exact.cost_curvature[k]),
+                    "imbalance": float(exact.imbalance[k]), "touching": int(exact.touching[k].sum())}
         mujoco.mj_setState(scene.model, scene.data, state, STATE)
         mujoco.mj_forward(scene.model, scene.data)
         depth_at = pipeline._palm_depth(planned.metric, heights, hand, pose, tip)
@@ -94,10 +98,18 @@ def frame(task: tuple[str, int, int, int, str | None]) -> list[dict]:
     return records
 
 
+def _pool_search(plan, hand, options) -> tuple:
+    """The hand (the fewest touching fingers) and safeguards (``default``'s, the balance computed, not required)
+    the pool is searched and its poses are evaluated with."""
+    guards = Safeguards(require_closure=options["require_closure"], friction=options["friction"],
+                        centring_gain=options["centring_gain"], max_imbalance=UNBALANCED)
+    return replace(plan.hand, min_touching=_fewest_touching(hand)), guards
+
+
 def _classes(planned, hand, options, screened: int, per_class: int) -> list[tuple]:
-    """(pose, grasp height, class, features) of the cheapest distinct poses of each class of the frame's pool."""
+    """(pose, grasp height, class) of the cheapest distinct poses of each class of the frame's pool."""
     plan, heights = planned.plan, planned.height_map
-    fewest = replace(plan.hand, min_touching=_fewest_touching(hand))
+    fewest, guards = _pool_search(plan, hand, options)
     screen = screen_grid(plan.efd, fewest, plan.grid, curvature=plan.curvature_mode,
                          centring_gain=options["centring_gain"])
     feasible = np.flatnonzero(screen.feasible)
@@ -105,8 +117,6 @@ def _classes(planned, hand, options, screened: int, per_class: int) -> list[tupl
     share = _screened_share(plan.efd, screen, np.full(len(screen.poses), np.nan), feasible)
     near = feasible[share <= hand.max_imbalance + tol.IMBALANCE_SCREEN]  # where the planner looks first
     cheapest = np.union1d(feasible[:screened], near[:screened])
-    guards = Safeguards(require_closure=options["require_closure"], friction=options["friction"],
-                        centring_gain=options["centring_gain"], max_imbalance=UNBALANCED)
     exact = evaluate_poses(plan.efd, fewest, screen.poses[cheapest], curvature=plan.curvature_mode,
                            d_min=plan.grid.d_min, safeguards=guards)
     rows = np.flatnonzero(exact.feasible)
@@ -121,9 +131,8 @@ def _classes(planned, hand, options, screened: int, per_class: int) -> list[tupl
         for balance in (True, False):
             members = exact.feasible & descends & (touching == count) & (balanced == balance)
             label = f"{count} fingers, {'balanced' if balance else 'unbalanced'}"
-            for i in distinct_best(replace(exact, feasible=members), plan.grid, per_class):
-                features = {"cost": float(exact.cost[i]), "imbalance": float(exact.imbalance[i])}
-                picks.append((exact.poses[i], float(tips[i]), label, features))
+            picks += [(exact.poses[i], float(tips[i]), label)
+                      for i in distinct_best(replace(exact, feasible=members), plan.grid, per_class)]
     return picks
 
 
@@ -159,9 +168,10 @@ def _first_of(*classes):
     return rule
 
 
-def _least(key):
-    """The rule picking the pool's pose least in ``key`` (the plan where the pool is empty)."""
-    return lambda records: min(records[1:] or records[:1], key=lambda r: r.get(key, np.inf))
+def _least(key, *, with_plan: bool = False):
+    """The rule picking the pool's pose (or, ``with_plan``, the pool's or the plan's) least in ``key(record)``
+    (the frame's only record where its pool is empty, or it had no plan)."""
+    return lambda records: min(records[0 if with_plan else 1:] or records[:1], key=key)
 
 
 #: Rules of choice among a frame's records (the planned pose first): the plan's, then alternatives.
@@ -170,8 +180,10 @@ RULES = {
     "balanced first, 4 then 3 then 2 fingers (the planner's order)": _first_of(
         *(f"{n} fingers, balanced" for n in (4, 3, 2))),
     "balanced first, 2 then 3 then 4 fingers": _first_of(*(f"{n} fingers, balanced" for n in (2, 3, 4))),
-    "the cheapest of any class": _least("cost"),
-    "the least imbalance": _least("imbalance"),
+    "the cheapest of any class": _least(lambda r: r.get("cost", np.inf)),
+    "the least imbalance": _least(lambda r: r.get("imbalance", np.inf)),
+    "the plan's or the pool's least curvature cost + 1000 x imbalance": _least(
+        lambda r: r.get("curvature_cost", np.inf) + 1000 * r.get("imbalance", np.inf), with_plan=True),
 }
 
 
