@@ -49,6 +49,7 @@ import numpy as np
 import pose_oracle
 from contourgrasp import pipeline
 from contourgrasp import tolerances as tol
+from contourgrasp.errors import InputError, NoFeasibleGrasp
 from contourgrasp.io.planner_file import load_planner
 from contourgrasp.sim import render, trial
 from contourgrasp.sim.ycb import load_object, object_names
@@ -77,7 +78,7 @@ def frame(task: tuple[str, int, int, int, str | None]) -> list[dict]:
     base = {"object": name, "seed": seed}
     try:
         planned = pipeline.plan_frame(rgb, depth, scene.camera.intrinsics, hand, **options)
-    except Exception as err:  # noqa: BLE001 -- a frame without a plan is reported, not fatal
+    except (NoFeasibleGrasp, InputError) as err:  # as a bench trial: a frame without a plan is reported
         return [base | {"class": "no plan", "success": False, "cause": str(err).splitlines()[0][:200]}]
     plan, heights = planned.plan, planned.height_map
     fewest, guards = _pool_search(plan, hand, options)
