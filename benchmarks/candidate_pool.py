@@ -52,7 +52,7 @@ from contourgrasp import tolerances as tol
 from contourgrasp.errors import InputError, NoFeasibleGrasp
 from contourgrasp.io.planner_file import load_planner
 from contourgrasp.sim import render, trial
-from contourgrasp.sim.ycb import load_object, object_names
+from contourgrasp.sim.ycb import object_names
 from contourgrasp.synthesis import evaluate_poses, screen_grid
 from contourgrasp.synthesis.descent import DESCENT_MARGIN, _raised, descent_feasible
 from contourgrasp.synthesis.grid import distinct_best
@@ -60,7 +60,6 @@ from contourgrasp.synthesis.outer import _fewest_touching, _screened_share
 from contourgrasp.synthesis.safeguards import Safeguards
 
 HAND = "five-finger-linear"
-STATE = mujoco.mjtState.mjSTATE_INTEGRATION
 #: Just below 1: the safeguards compute each pose's imbalance without requiring any balance.
 UNBALANCED = 1.0 - 1e-9
 
@@ -69,12 +68,10 @@ def frame(task: tuple[str, int, int, int, str | None]) -> list[dict]:
     """The planned pose and the executed classes of one frame's pool, one record each."""
     warnings.simplefilter("ignore")
     name, seed, screened, per_class, hand_model = task
-    simulated, hand = pose_oracle._hand(HAND, hand_model)
+    _, hand = pose_oracle._hand(HAND, hand_model)
     options = load_planner("default").plan_options
-    scene = trial.trial_scene(load_object(name), seed=seed, hand=simulated)
+    scene, state, _, _ = pose_oracle._scene(name, seed, "single", (), HAND, hand_model)
     rgb, depth = render(scene, noise=True, seed=seed)
-    state = np.empty(mujoco.mj_stateSize(scene.model, STATE))
-    mujoco.mj_getState(scene.model, scene.data, state, STATE)
     base = {"object": name, "seed": seed}
     try:
         planned = pipeline.plan_frame(rgb, depth, scene.camera.intrinsics, hand, **options)
@@ -89,7 +86,7 @@ def frame(task: tuple[str, int, int, int, str | None]) -> list[dict]:
     for k, (pose, tip, label) in enumerate(executed):
         features = {"cost": float(exact.cost[k]), "curvature_cost": float(exact.cost_curvature[k]),
                     "imbalance": float(exact.imbalance[k]), "touching": int(exact.touching[k].sum())}
-        mujoco.mj_setState(scene.model, scene.data, state, STATE)
+        mujoco.mj_setState(scene.model, scene.data, state, pose_oracle.STATE)
         mujoco.mj_forward(scene.model, scene.data)
         depth_at = pipeline._palm_depth(planned.metric, heights, hand, pose, tip)
         outcome = trial.execute_grasp(scene, pipeline.hand_pose(planned.metric, pose, depth_at),

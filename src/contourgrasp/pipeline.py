@@ -199,14 +199,14 @@ def plan_frame(
     closing_sweep : bool
         With ``descent``: also refuse a pose where a touching finger's chain would meet the scene
         before its tip reaches its grasp point (:mod:`contourgrasp.synthesis.sweep`).
-    low_objects : bool
-        Plan an object lower than ``tolerances.LOW_OBJECT_HEIGHT`` (its height map's ``max_height``) first as a
-        pinch of the thumb against one finger with the fingertips as balls (:func:`~contourgrasp.synthesis.search`'s
-        ``low_object``); needs a table (the height map).
     closing_obstacles : bool
         With ``descent``: also refuse a pose where a finger, closing until it meets the target (or to
         its end, if it misses), would run into a neighbouring object or a bin's wall -- the height
         map's obstacle cells (:func:`contourgrasp.synthesis.sweep.closing_hits`).
+    low_objects : bool
+        Plan an object lower than ``tolerances.LOW_OBJECT_HEIGHT`` (its height map's ``max_height``) first as a
+        pinch of the thumb against one finger with the fingertips as balls (:func:`~contourgrasp.synthesis.search`'s
+        ``low_object``); needs a table (the height map).
     **synthesis_options
         Keyword options of :func:`contourgrasp.synthesis.search`.
 
