@@ -141,3 +141,22 @@ def contact_imbalance(coefficients, period, t, touching, min_normal):
         if count:
             out[p] = math.hypot(sx, sy) / count
     return out
+
+
+@njit(cache=True)
+def centring_distances(poses, n_yaw, centre, locus):
+    """(p,) float: :func:`contourgrasp.synthesis.cost.centring_distance`'s loop, the pinch centre rotated once per yaw.
+
+    ``n_yaw``: the poses' yaws repeat with this period (as :func:`score_poses`'s); ``centre`` (2,) the
+    hand's pinch centre in the hand frame, ``locus`` (2,) the object's centre in the image plane.
+    """
+    n_poses = poses.shape[0]
+    out = np.empty(n_poses)
+    placed = np.empty((min(n_yaw, n_poses), 2))  # R(yaw) pinch centre, per yaw
+    for r in range(placed.shape[0]):
+        c, s = math.cos(poses[r, 2]), math.sin(poses[r, 2])
+        placed[r, 0], placed[r, 1] = c * centre[0] - s * centre[1], s * centre[0] + c * centre[1]
+    for p in range(n_poses):
+        r = p % n_yaw
+        out[p] = math.hypot(locus[0] - poses[p, 0] - placed[r, 0], locus[1] - poses[p, 1] - placed[r, 1])
+    return out

@@ -27,7 +27,7 @@ import numpy as np
 from .. import tolerances as tol
 from ..errors import PlannerError
 from ..hand import Hand
-from ._cost_kernels import ratio_cost_rows, score_poses
+from ._cost_kernels import centring_distances, ratio_cost_rows, score_poses
 from ._derived import hand_arrays
 from .plan import PoseEvaluation
 from .safeguards import Safeguards
@@ -110,11 +110,7 @@ def centring_distance(hand: Hand, poses, locus, *, n_yaw: int | None = None) -> 
     """
     poses = np.asarray(poses, dtype=float)
     period = n_yaw if n_yaw and len(poses) >= n_yaw and len(poses) % n_yaw == 0 else max(len(poses), 1)
-    c, s = np.cos(poses[:period, 2]), np.sin(poses[:period, 2])
-    cx, cy = hand.pinch_centre
-    gap_x = (locus[0] - poses[:, 0]).reshape(-1, period) - (c * cx - s * cy)  # locus - (xy + R(yaw) pinch centre)
-    gap_y = (locus[1] - poses[:, 1]).reshape(-1, period) - (s * cx + c * cy)
-    return np.hypot(gap_x, gap_y).reshape(-1)
+    return centring_distances(poses, period, np.asarray(hand.pinch_centre, dtype=float), np.asarray(locus, dtype=float))
 
 
 def score(hand: Hand, poses, touching, lam, t, point, curv, start_inside, d_min, clear, epsilon,
