@@ -296,3 +296,29 @@ def test_the_small_object_rule_closes_fingertip_balls_on_an_object_the_points_ca
     with pytest.raises(NoFeasibleGrasp) as points:  # fingers of radius 0 are points: nothing to grow
         cg.synthesize(small, _pincer(0.0), small_objects=True, **grid)
     assert "balls" not in str(points.value)
+
+
+def test_widening_the_exact_evaluation_evaluates_each_pose_once_and_keeps_the_full_evaluations_answer(monkeypatch):
+    from contourgrasp.synthesis import outer
+    from contourgrasp.synthesis.grid import SearchGrid, screen_grid
+    from contourgrasp.synthesis.safeguards import Safeguards
+
+    hand, grid = cg.load_hand("five-finger-linear"), SearchGrid(**FINE)
+    model = efd.fit(cg.example_contour("can"), 4)
+    screen = screen_grid(model, hand, grid)
+    cheapest = np.flatnonzero(screen.feasible)[np.argsort(screen.cost[screen.feasible], kind="stable")]
+    refused = {tuple(p) for p in screen.poses[cheapest[:10]]}  # the 10 cheapest fail exactly: the set must widen twice
+    sizes, evaluate = [], outer.evaluate_poses
+
+    def failing_the_first_ten(model, hand, poses, **options):
+        sizes.append(len(poses))
+        result = evaluate(model, hand, poses, **options)
+        return replace(result, feasible=result.feasible & [tuple(p) not in refused for p in poses])
+
+    monkeypatch.setattr(outer, "evaluate_poses", failing_the_first_ten)
+    widened = outer._reevaluate_best(model, hand, screen, 2, "paper", grid.d_min, Safeguards())
+    assert sizes == [2, 6, 24]  # 2, then 8 and 32 in all: each pose once
+    whole = failing_the_first_ten(model, hand, screen.poses[cheapest[:32]], d_min=grid.d_min)
+    np.testing.assert_array_equal(widened.poses, whole.poses)
+    np.testing.assert_array_equal(widened.feasible, whole.feasible)
+    np.testing.assert_allclose(widened.cost, whole.cost, rtol=0, atol=1e-12)
