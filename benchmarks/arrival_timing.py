@@ -14,6 +14,11 @@ than planned, over the contacts both within the closing ramp, and the spread
 of the planned arrivals within a plan (how balanced the plan itself is by
 the free-air timing).
 
+It also compares the fingers the plan has *missing* -- closing on air, their
+closest approach ``gap`` short of the outline -- with the fingers that touched
+in the trial: per band of ``gap``, how many touched anyway; and the trials'
+success with and without such an unplanned contact.
+
 Usage::
 
     .venv/bin/python benchmarks/arrival_timing.py --hand-model inspire --objects ycb-train --trials 4
@@ -58,11 +63,15 @@ def main(argv=None) -> int:
     setup = bench.Bench(objects=objects, planners=("default",), trials=args.trials, hand=hand, hand_model=mounted,
                         splits=splits)
     late, spread = {name: [] for name in closing.names}, []
+    gaps, unplanned = [], {True: [], False: []}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         for obj in setup.objects:
             for trial in range(args.trials):
-                planned, observed = _trial(setup, obj, trial, closing)
+                planned, observed, missed, success = _trial(setup, obj, trial, closing)
+                gaps += [(gap, name in observed) for name, gap in missed.items()]
+                if planned:
+                    unplanned[bool(missed.keys() & observed.keys())].append(success)
                 if len(planned) > 1:
                     spread.append(max(planned.values()) - min(planned.values()))
                 for name, at in planned.items():
@@ -76,11 +85,27 @@ def main(argv=None) -> int:
     if spread:
         print(f"planned arrivals within a plan: spread median {np.median(spread):.3f} s, "
               f"90th percentile {np.percentile(spread, 90):.3f} s ({len(spread)} plans)")
+    _print_missed(gaps, unplanned)
     return 0
 
 
+#: Bands of a missed finger's planned ``gap``, m.
+GAP_BANDS = (0.0, 0.003, 0.006, 0.009, 0.012, 0.02, 0.05, np.inf)
+
+
+def _print_missed(gaps, unplanned) -> None:
+    """The fingers planned to miss that touched anyway, per band of their gap; success with and without one."""
+    print("fingers the plan has missing: planned gap, mm | fingers | touched in the trial")
+    for lo, hi in zip(GAP_BANDS, GAP_BANDS[1:]):
+        touched = [t for gap, t in gaps if lo <= gap < hi]
+        print(f"{1e3 * lo:3.0f}-{1e3 * hi:<3.0f} | {len(touched):4d} | {sum(touched):4d}")
+    for flag, label in ((True, "with a finger planned missing touching"), (False, "without")):
+        print(f"trials {label}: {len(unplanned[flag])}, lifted {sum(unplanned[flag])}")
+
+
 def _trial(setup, obj, trial, closing):
-    """(planned, observed): per finger the planned arrival and the first contact, s."""
+    """(planned, observed, missed, success): per finger the planned arrival and the first contact, s; the
+    planned gap of each finger the plan has missing, m; whether the trial lifted the object."""
     planner, plans = make_planner("default", setup.hand, seed=setup.seed + trial), []
 
     def plan(rgb, depth, intrinsics, **target):
@@ -89,12 +114,14 @@ def _trial(setup, obj, trial, closing):
         return planned.T_camera_hand, planned.approach_depth, planned.grasp_height
 
     record = setup.run("default", obj, trial, plan=plan)
-    planned = {}
+    planned, missed = {}, {}
     if plans and plans[0] is not None:
         for i, finger in enumerate(plans[0].fingers):
-            if not finger.missed:
+            if finger.missed:
+                missed[finger.name] = finger.gap
+            else:
                 planned[finger.name] = float(closing.arrival_times(i, np.array([finger.lam]))[0])
-    return planned, dict(record.first_contact)
+    return planned, dict(record.first_contact), missed, record.success
 
 
 if __name__ == "__main__":

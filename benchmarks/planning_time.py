@@ -3,8 +3,8 @@
 One simulated RGB-D frame per thesis object (seed 3 unless ``--seed``, depth noise on), planned with
 the `five-finger-linear` hand: perception, synthesis and the 6-DoF pose, exactly
 what a bench trial's planner does. Prints, per planner and object, the median
-wall time of 5 runs after a warm-up, and the synthesis's share (its
-``timing_ms.total``). One thread (set before numpy is imported). ``--cpu``
+wall time of 5 runs (``--runs``) after a warm-up, the slowest of them, and the
+synthesis's share (its ``timing_ms.total``). One thread (set before numpy is imported). ``--cpu``
 times the process's CPU time instead of the wall clock (steadier on a
 loaded machine); ``--real`` also plans the real frames with hand-made masks
 (``benchmarks/segmentation.py``'s, in ``../shared/data``), perception
@@ -13,6 +13,7 @@ included.
 Usage::
 
     .venv/bin/python benchmarks/planning_time.py [--planners paper,default] [--cpu] [--real] [--objects ...] [--seed N]
+        [--runs N]
 
 ``--objects`` takes the bench's object names (the thesis's five by default; ``ycb:<id>`` for a YCB
 object, ``ycb-train`` for the whole training split); a frame without a plan reads "nan ms".
@@ -49,8 +50,9 @@ def simulated_frame(obj: str, seed: int = SEED):
     return (*render(scene, noise=True, seed=seed), scene.camera.intrinsics)
 
 
-def frame_times(planner: str, frame, clock=time.perf_counter) -> tuple[float, float]:
-    """Median time (``clock``) of ``plan_frame`` on one (rgb, depth, intrinsics) frame and its synthesis time, ms."""
+def frame_times(planner: str, frame, clock=time.perf_counter, runs: int = RUNS) -> tuple[float, float, float]:
+    """Median and slowest time (``clock``) of ``runs`` ``plan_frame`` on one (rgb, depth, intrinsics) frame, and
+    its median synthesis time, ms."""
     rgb, depth, camera = frame
     hand = load_hand("five-finger-linear")
     options = load_planner(planner).plan_options
@@ -59,14 +61,14 @@ def frame_times(planner: str, frame, clock=time.perf_counter) -> tuple[float, fl
         walls, synthesis = [], []
         try:
             pipeline.plan_frame(rgb, depth, camera, hand, **options)  # warm-up: numba's compilation, caches
-            for _ in range(RUNS):
+            for _ in range(runs):
                 start = clock()
                 result = pipeline.plan_frame(rgb, depth, camera, hand, **options)
                 walls.append(1e3 * (clock() - start))
                 synthesis.append(result.plan.timing_ms["total"])
         except NoFeasibleGrasp:
-            return math.nan, math.nan
-    return statistics.median(walls), statistics.median(synthesis)
+            return math.nan, math.nan, math.nan
+    return statistics.median(walls), max(walls), statistics.median(synthesis)
 
 
 def real_frames() -> dict:
@@ -85,17 +87,21 @@ def main() -> None:
     parser.add_argument("--objects", default=",".join(OBJECTS),
                         help="comma list of bench object names or sets (e.g. ycb:025_mug, ycb-train)")
     parser.add_argument("--seed", type=int, default=SEED, help="the bench trial's seed of every simulated frame")
+    parser.add_argument("--runs", type=int, default=RUNS, help="timed plans per frame, after one untimed")
     args = parser.parse_args()
+    if args.runs < 1:
+        parser.error(f"--runs must be at least 1, got {args.runs}")
     cv2.setNumThreads(1)
     clock = time.process_time if args.cpu else time.perf_counter
     frames = {obj: simulated_frame(obj, args.seed) for obj in object_names(args.objects)} | (real_frames() if args.real else {})
-    print(f"{'CPU' if args.cpu else 'wall'} time of plan_frame, median of {RUNS} (synthesis: its timing_ms.total, "
-          f"wall time)\n")
+    print(f"{'CPU' if args.cpu else 'wall'} time of plan_frame, median of {args.runs} (the slowest of them; synthesis: "
+          f"its timing_ms.total, wall time)\n")
     print("| planner | " + " | ".join(frames) + " |")
     print("|---|" + "---:|" * len(frames))
     for planner in args.planners.split(","):
-        cells = [frame_times(planner, frame, clock) for frame in frames.values()]
-        print(f"| {planner} | " + " | ".join(f"{w:.0f} ms (synthesis {s:.0f})" for w, s in cells) + " |")
+        cells = [frame_times(planner, frame, clock, args.runs) for frame in frames.values()]
+        print(f"| {planner} | " + " | ".join(f"{w:.0f} ms (slowest {m:.0f}; synthesis {s:.0f})" for w, m, s in cells)
+              + " |")
     print(f"\nload average at end: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
 
 

@@ -1,5 +1,6 @@
 """The search (synthesis.outer): plans on the examples, invariances, options, infeasibility."""
 
+import gc
 import math
 from dataclasses import replace
 
@@ -272,6 +273,21 @@ def test_an_attempts_reason_is_worked_out_once_and_only_when_asked():
     assert calls == [] and isinstance(failure, NoFeasibleGrasp)
     assert str(failure) == failure.reason == "blocked" and calls == [1]
 
+
+
+def test_a_search_whose_first_attempts_fail_leaves_nothing_for_the_garbage_collector():
+    """The failed attempts are kept for the no-plan message. Kept with their tracebacks, they held the
+    search's frames, and so every screen of the grid, in reference cycles that only the cyclic garbage
+    collector frees, late and in bulk (``benchmarks/planning_time.md``, "The slow plan in every few")."""
+    plan = cg.synthesize(cg.example_contour("can"), "five-finger-linear", planner="default")
+    assert plan.hand.min_touching < cg.load_hand("five-finger-linear").min_touching  # attempts failed before it
+    gc.collect()
+    gc.disable()
+    try:
+        cg.synthesize(cg.example_contour("can"), "five-finger-linear", planner="default")
+        assert gc.collect() == 0
+    finally:
+        gc.enable()
 
 def _pincer(radius: float) -> cg.Hand:
     """Two fingers closing on a line toward each other; their travels end 20 mm apart."""

@@ -266,8 +266,8 @@ def _search_outline(contour, *, hand: Hand, grid: SearchGrid, safeguards: Safegu
                                       _needing(screen, touch_counts, touching), grid, guards, descent,
                                       curvature=curvature, top_k=top_k, refine=refine,
                                       times=(clock, fitted, searched), share=share)
-            except NoFeasibleGrasp as err:
-                errors.append(err)
+            except NoFeasibleGrasp as err:  # kept without its traceback: through this frame that would make a
+                errors.append(err.with_traceback(None))  # cycle holding every screen until the gc runs
         return None
 
     if (plan := attempt(safeguards)) is not None:
