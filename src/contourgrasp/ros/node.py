@@ -35,6 +35,7 @@ from rclpy.node import Node
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import CameraInfo, Image
 from std_srvs.srv import Trigger
+from threadpoolctl import ThreadpoolController
 from visualization_msgs.msg import MarkerArray
 
 from .. import load_hand, load_planner, plan_grasp
@@ -158,6 +159,7 @@ class ContourGraspNode(Node):
         self.pairer = Pairer(self.settings.pair_tolerance)
         self.camera_info = None
         self.latencies_ms: list[float] = []
+        self.blas = ThreadpoolController()
         self._subscribe()
         self.grasp_publisher = self.create_publisher(PoseStamped, "~/grasp", 10)
         self.pregrasp_publisher = self.create_publisher(PoseStamped, "~/pregrasp", 10)
@@ -250,7 +252,9 @@ class ContourGraspNode(Node):
     def _planned(self, colour, depth):
         if self.camera_info is None:
             raise InputError("no camera_info received yet")
-        with warnings.catch_warnings(record=True) as caught:
+        # One BLAS thread: numpy's OpenBLAS spins a second core through every plan, and it plans no faster
+        # (README, "Latency"); limited while planning only, as the node may share its process.
+        with warnings.catch_warnings(record=True) as caught, self.blas.limit(limits=1, user_api="blas"):
             warnings.simplefilter("always")
             rgb, d, intrinsics = messages.rgbd_arrays(colour, depth, self.camera_info)
             result = plan_grasp(rgb, d, intrinsics, self.settings.hand, planner=self.settings.planner,
