@@ -81,7 +81,7 @@ def measure(frames: int, warmup: int, planner: str, hand: str) -> tuple[list[flo
             if not spin_until(executor, lambda: stamp in grasps, TIMEOUT):
                 raise SystemExit(f"frame {i}: no ~/grasp in {TIMEOUT} s (a frame lost? see the node's log)")
             loop.append(1e3 * (grasps[stamp] - sent))
-        return node.latencies_ms[warmup:], loop[warmup:], 1e3 * (time.process_time() - cpu) / frames
+        return list(node.latencies_ms)[warmup:], loop[warmup:], 1e3 * (time.process_time() - cpu) / frames
     finally:
         executor.shutdown(timeout_sec=5)
         node.destroy_node()

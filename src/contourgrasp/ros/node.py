@@ -24,6 +24,7 @@ import math
 import signal
 import time
 import warnings
+from collections import deque
 from dataclasses import dataclass, field, replace
 
 import rclpy
@@ -132,14 +133,18 @@ def _require(ok: bool, name: str, what: str, values: dict) -> None:
         raise InputError(f"parameter {name}: {what}, got {values[name]!r}")
 
 
+#: Plans whose latency the node keeps (``latencies_ms``): a node running for days must not grow.
+LATENCIES_KEPT = 10_000
+
+
 class ContourGraspNode(Node):
     """The ``contourgrasp`` node (module docstring); ``kwargs`` go to :class:`rclpy.node.Node`.
 
     Attributes
     ----------
     settings : Settings
-    latencies_ms : list of float
-        Per plan published: time from the message that completed the frame
+    latencies_ms : deque of float
+        Per plan published, the last ``LATENCIES_KEPT``: time from the message that completed the frame
         (continuous) or the service call to the poses published, ms.
 
     Raises
@@ -158,7 +163,7 @@ class ContourGraspNode(Node):
             raise
         self.pairer = Pairer(self.settings.pair_tolerance)
         self.camera_info = None
-        self.latencies_ms: list[float] = []
+        self.latencies_ms: deque[float] = deque(maxlen=LATENCIES_KEPT)
         self.blas = ThreadpoolController()
         self._subscribe()
         self.grasp_publisher = self.create_publisher(PoseStamped, "~/grasp", 10)
