@@ -14,6 +14,7 @@ import os
 import statistics
 import time
 
+from contourgrasp.errors import InputError, NoFeasibleGrasp
 from contourgrasp.sim import bench
 from contourgrasp.sim.planners import make_planner
 from contourgrasp.sim.render import render
@@ -41,13 +42,13 @@ def stages(setup: bench.Bench) -> dict[str, list[float]]:
         t1 = time.perf_counter()
         rgb, depth = render(scene, noise=setup.noise, seed=seed)
         t2 = time.perf_counter()
-        try:
-            transform, depth_ = planner(rgb, depth, setup.camera.intrinsics)
-        except Exception:  # noqa: BLE001 -- no plan: no physics to time
+        try:  # as run_trial calls a planner: the pose, the approach depth and, planned, the grasp height
+            transform, approach_depth, *height = planner(rgb, depth, setup.camera.intrinsics)
+        except (NoFeasibleGrasp, InputError):  # no plan: no physics to time
             transform = None
         t3 = time.perf_counter()
         if transform is not None:
-            execute_grasp(scene, transform, depth_)
+            execute_grasp(scene, transform, approach_depth, grasp_height=height[0] if height else None)
         t4 = time.perf_counter()
         for stage, seconds in zip(spent, (t1 - t0, t2 - t1, t3 - t2, t4 - t3)):
             spent[stage].append(seconds)

@@ -18,3 +18,10 @@ def rotate(points: np.ndarray, angle: float, about=(0.0, 0.0)) -> np.ndarray:
 @pytest.fixture
 def circle():
     return disc(0.04)
+
+
+def blas_threads() -> set[int]:
+    """The thread counts of numpy's BLAS libraries loaded in this process."""
+    from threadpoolctl import threadpool_info
+
+    return {pool["num_threads"] for pool in threadpool_info() if pool["user_api"] == "blas"}

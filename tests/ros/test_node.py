@@ -194,25 +194,20 @@ def test_a_bad_message_gives_one_warning_and_success_false_then_the_next_good_fr
 
 
 
-def _blas_threads() -> list[int]:
-    from threadpoolctl import threadpool_info
-
-    return [pool["num_threads"] for pool in threadpool_info() if pool["user_api"] == "blas"]
-
-
 def test_the_node_plans_with_one_blas_thread_and_leaves_the_process_its_own(rig, monkeypatch):
     from threadpoolctl import threadpool_limits
+    from conftest import blas_threads
 
     import contourgrasp.ros.node as node_module
 
     node, camera = rig
     during, plan_grasp = [], node_module.plan_grasp
-    monkeypatch.setattr(node_module, "plan_grasp", lambda *a, **k: during.append(_blas_threads()) or plan_grasp(*a, **k))
+    monkeypatch.setattr(node_module, "plan_grasp", lambda *a, **k: during.append(blas_threads()) or plan_grasp(*a, **k))
     with threadpool_limits(limits=2, user_api="blas"):
-        assert _blas_threads() and set(_blas_threads()) == {2}
+        assert blas_threads() == {2}
         camera.send(node, *good_frame())
         assert camera.call().success
-        assert during == [[1] * len(_blas_threads())] and set(_blas_threads()) == {2}
+        assert during == [{1}] and blas_threads() == {2}
 
 def test_no_frame_until_a_colour_and_a_depth_image_pair_within_the_tolerance(ros):
     node, camera = _started(ros, "/fresh")

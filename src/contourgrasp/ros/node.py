@@ -36,7 +36,6 @@ from rclpy.node import Node
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import CameraInfo, Image
 from std_srvs.srv import Trigger
-from threadpoolctl import ThreadpoolController
 from visualization_msgs.msg import MarkerArray
 
 from .. import load_hand, load_planner, plan_grasp
@@ -44,6 +43,7 @@ from ..errors import InputError, NoFeasibleGrasp
 from ..hand import Hand
 from ..io.plan_file import image_plan_to_dict
 from ..io.planner_file import Planner
+from ..threads import one_blas_thread
 from . import messages
 from .pairing import PAIR_TOLERANCE, Pairer
 
@@ -164,7 +164,6 @@ class ContourGraspNode(Node):
         self.pairer = Pairer(self.settings.pair_tolerance)
         self.camera_info = None
         self.latencies_ms: deque[float] = deque(maxlen=LATENCIES_KEPT)
-        self.blas = ThreadpoolController()
         self._subscribe()
         self.grasp_publisher = self.create_publisher(PoseStamped, "~/grasp", 10)
         self.pregrasp_publisher = self.create_publisher(PoseStamped, "~/pregrasp", 10)
@@ -257,9 +256,8 @@ class ContourGraspNode(Node):
     def _planned(self, colour, depth):
         if self.camera_info is None:
             raise InputError("no camera_info received yet")
-        # One BLAS thread: numpy's OpenBLAS spins a second core through every plan, and it plans no faster
-        # (README, "Latency"); limited while planning only, as the node may share its process.
-        with warnings.catch_warnings(record=True) as caught, self.blas.limit(limits=1, user_api="blas"):
+        # limited while planning only: the node may share its process
+        with warnings.catch_warnings(record=True) as caught, one_blas_thread():
             warnings.simplefilter("always")
             rgb, d, intrinsics = messages.rgbd_arrays(colour, depth, self.camera_info)
             result = plan_grasp(rgb, d, intrinsics, self.settings.hand, planner=self.settings.planner,

@@ -23,6 +23,19 @@ def test_two_workers_give_the_serial_trials_bit_for_bit(serial_bench, tmp_path):
     assert [line for line in table if "time" not in line] == [line for line in serial if "time" not in line]
 
 
+def test_a_trial_runs_with_numpys_blas_on_one_thread(monkeypatch):
+    from threadpoolctl import threadpool_limits
+
+    from conftest import blas_threads
+    from contourgrasp.sim.bench import trial_task
+
+    bench, during, run = Bench(objects=thesis_objects(["can"]), planners=("paper",), trials=1), [], Bench.run
+    monkeypatch.setattr(Bench, "run", lambda self, *task: during.append(blas_threads()) or run(self, *task))
+    with threadpool_limits(limits=2, user_api="blas"):
+        assert trial_task(bench, "paper", 0, 0).record.object == "can"
+        assert during == [{1}] and blas_threads() == {2}
+
+
 def test_a_local_ray_gives_the_serial_trials(serial_bench, tmp_path):
     pytest.importorskip("ray", reason="ray is not installed (pip install 'contourgrasp[cluster]')")
     assert main([*SMALL, "--ray", "--workers", "2", "--out", str(tmp_path)]) == 0

@@ -25,6 +25,7 @@ from concurrent.futures.process import BrokenProcessPool
 from urllib.parse import urlsplit
 
 from ...errors import SimulationError
+from ...threads import one_blas_thread
 from ...validation import integer
 from .config import Bench, BenchTrial
 
@@ -47,8 +48,10 @@ def cores() -> int:
 
 
 def trial_task(bench: Bench, planner: str, index: int, trial: int) -> BenchTrial:
-    """Trial ``trial`` (0-based) of ``planner`` on ``bench.objects[index]``."""
-    return BenchTrial(planner, trial, bench.run(planner, bench.objects[index], trial))
+    """Trial ``trial`` (0-based) of ``planner`` on ``bench.objects[index]``, with numpy's BLAS on one thread
+    (:mod:`contourgrasp.threads`: a second would spin a core the other workers need)."""
+    with one_blas_thread():
+        return BenchTrial(planner, trial, bench.run(planner, bench.objects[index], trial))
 
 
 @contextlib.contextmanager
