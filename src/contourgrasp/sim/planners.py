@@ -1,7 +1,8 @@
 """Planners for simulated trials: the library's pipeline under named settings, and two baselines.
 
 A planner is what :func:`~contourgrasp.sim.trial.run_trial` calls:
-``planner(rgb, depth, intrinsics, *, target_px=None) -> (T_camera_hand, approach_depth)``,
+``planner(rgb, depth, intrinsics, *, target_px=None) -> (T_camera_hand, approach_depth, grasp_height)``
+(``grasp_height`` None where the planner chose none),
 raising :class:`~contourgrasp.errors.NoFeasibleGrasp` or
 :class:`~contourgrasp.errors.InputError` when it has no plan; ``target_px``,
 given in a scene of several objects, is the pixel (u, v) on the object to
