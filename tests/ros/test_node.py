@@ -193,7 +193,6 @@ def test_a_bad_message_gives_one_warning_and_success_false_then_the_next_good_fr
     np.testing.assert_array_equal(json.loads(response.message)["T_camera_hand"], reference.T_camera_hand)
 
 
-
 def test_the_node_plans_with_one_blas_thread_and_leaves_the_process_its_own(rig, monkeypatch):
     from threadpoolctl import threadpool_limits
     from conftest import blas_threads
@@ -208,6 +207,7 @@ def test_the_node_plans_with_one_blas_thread_and_leaves_the_process_its_own(rig,
         camera.send(node, *good_frame())
         assert camera.call().success
         assert during == [{1}] and blas_threads() == {2}
+
 
 def test_no_frame_until_a_colour_and_a_depth_image_pair_within_the_tolerance(ros):
     node, camera = _started(ros, "/fresh")

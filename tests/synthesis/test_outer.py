@@ -274,7 +274,6 @@ def test_an_attempts_reason_is_worked_out_once_and_only_when_asked():
     assert str(failure) == failure.reason == "blocked" and calls == [1]
 
 
-
 def test_a_search_whose_first_attempts_fail_leaves_nothing_for_the_garbage_collector():
     """The failed attempts are kept for the no-plan message. Kept with their tracebacks, they held the
     search's frames, and so every screen of the grid, in reference cycles that only the cyclic garbage
@@ -288,6 +287,7 @@ def test_a_search_whose_first_attempts_fail_leaves_nothing_for_the_garbage_colle
         assert gc.collect() == 0
     finally:
         gc.enable()
+
 
 def _pincer(radius: float) -> cg.Hand:
     """Two fingers closing on a line toward each other; their travels end 20 mm apart."""
