@@ -242,6 +242,17 @@ def test_refusing_early_keeps_every_verdict_and_the_feasible_poses_exact(hand):
         descent_feasible(hand, wall, poses, TIP, refuse_below=np.nan)
 
 
+def test_a_pose_refused_like_the_one_before_it_walks_that_body_alone(hand):
+    # a post under the palm only: two poses alike are both refused by the palm, the last body; the first pose
+    # walks every body up to it, the second starts with the palm and stops there
+    post = scene(lambda x, y: np.where((np.abs(x) < 0.01) & (np.abs(y - 0.14) < 0.01), 0.2, 0.0))
+    check = descent_feasible(hand, post, [[0.0, 0.0, 0.0]] * 2, TIP, refuse_below=-0.01)
+    assert not check.feasible.any() and (check.blocking == len(body_names(hand)) - 1).all()
+    assert np.isfinite(check.clearance[0]).all()
+    assert np.isfinite(check.clearance[1]).tolist() == [False] * (len(body_names(hand)) - 1) + [True]
+    assert check.clearance[1, -1] == check.clearance[0, -1]
+
+
 def test_bad_arguments_are_refused_by_name(hand):
     hm = scene(lambda x, y: 0.0)
     with pytest.raises(HandError, match="no 3-D geometry"):

@@ -37,6 +37,21 @@ def test_compiled_grid_screen_matches_the_numpy_inner_problem(hand, steps):
     np.testing.assert_allclose(screen.cost[both], exact.cost[both], rtol=1e-2 if has_arc else 2e-3, atol=0.05)
 
 
+@pytest.mark.parametrize("touching", [1, 3])
+def test_the_reaching_screen_is_the_full_screen_where_enough_fingers_touch(touching):
+    hand = dataclasses.replace(cg.load_hand("five-finger-linear"), min_touching=touching)
+    model = efd.fit(cg.example_contour("stone1"))
+    grid = synthesis.SearchGrid(xy_step=0.03, yaw_step=math.radians(7))
+    full = synthesis.screen_grid(model, hand, grid)
+    reaching, any_outside = synthesis.screen_reaching(model, hand, grid)
+    kept = full.touching.sum(axis=1) >= touching
+    assert 0 < kept.sum() < len(full.poses)
+    for field in dataclasses.fields(full):
+        np.testing.assert_array_equal(getattr(reaching, field.name), getattr(full, field.name)[kept], err_msg=field.name)
+    np.testing.assert_array_equal(np.flatnonzero(full.feasible), np.flatnonzero(kept)[reaching.feasible])
+    assert any_outside == bool(full.starts_outside.any())
+
+
 def test_curved_thumb_cells_match_brute_force_on_a_large_and_a_tiny_object():
     """The arc's later chords look edges up in cells: objects much larger and smaller than a cell."""
     hand = cg.load_hand("five-finger-curved-thumb")

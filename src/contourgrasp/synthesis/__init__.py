@@ -10,7 +10,7 @@
 * :mod:`~contourgrasp.synthesis.evaluate` — inner problem and cost exactly at any poses
   (:func:`evaluate_poses`);
 * :mod:`~contourgrasp.synthesis.grid` — the pose grid (eq 3.33, 3.39-3.40, :class:`SearchGrid`), its
-  compiled screen (:func:`screen_grid`) and distinct best poses;
+  compiled screen (:func:`screen_grid`, :func:`screen_reaching`) and distinct best poses;
 * :mod:`~contourgrasp.synthesis.refine` — continuous refinement off the grid (:func:`refine_poses`);
 * :mod:`~contourgrasp.synthesis.descent` — the open 3-D hand's descent onto the scene's height map
   (:class:`Descent`, :func:`descent_feasible`, :func:`descent_floor`), a constraint of the search;
@@ -23,7 +23,7 @@
 from .cost import distance, ratio_cost
 from .descent import Descent, DescentCheck, descent_clearance, descent_feasible, descent_floor
 from .evaluate import evaluate_poses
-from .grid import SearchGrid, distinct_best, screen_grid
+from .grid import SearchGrid, distinct_best, screen_grid, screen_reaching
 from .inner import closest_approach, first_touch
 from .outer import search
 from .plan import Alternative, Cost, FingerContact, GraspPlan, PoseEvaluation, Refinement
@@ -33,5 +33,5 @@ from .safeguards import Safeguards, fingers_clear, grasp_epsilon, grasp_imbalanc
 __all__ = [
     "Alternative", "Cost", "Descent", "DescentCheck", "FingerContact", "GraspPlan", "PoseEvaluation", "Refinement", "Safeguards",
     "SearchGrid", "closest_approach", "descent_clearance", "descent_feasible", "descent_floor", "distance", "distinct_best", "evaluate_poses", "fingers_clear",
-    "first_touch", "grasp_epsilon", "grasp_imbalance", "ratio_cost", "refine_poses", "screen_grid", "search",
+    "first_touch", "grasp_epsilon", "grasp_imbalance", "ratio_cost", "refine_poses", "screen_grid", "screen_reaching", "search",
 ]

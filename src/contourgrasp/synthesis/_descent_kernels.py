@@ -115,50 +115,67 @@ def _palm_gap(layer, origin, cell, normal, i, k, x, y, c, s, outline, plane, bas
 def clearances(layer, origin, cell, normal, poses, base, ends, radii, palm, plane, vertical, stop, only_below, out):
     """Fill out (p, n_capsules + 1): per pose the least gap of each capsule (ends (n, 2, 3), radii (n,)) and the palm
     (its outline (k, 2) and underside plane (3,)); a pose's walk ends at a gap below its ``stop`` (p,), and skips
-    the cells that cannot bring a gap below its ``only_below`` (p,)."""
-    nx_, ny_, nz_ = normal[0], normal[1], normal[2]
+    the cells that cannot bring a gap below its ``only_below`` (p,).
+
+    A pose's walk starts with the body that ended the last refused pose's: neighbouring candidates tend to
+    strike with the same body, and a refused pose's other bodies need no walk (they are +inf either way).
+    """
+    n_bodies = ends.shape[0] + 1
+    first = -1
     for p in range(poses.shape[0]):
-        x, y, c, s = poses[p, 0], poses[p, 1], math.cos(poses[p, 2]), math.sin(poses[p, 2])
         refused = False
-        for j in range(ends.shape[0] + 1):
+        for step in range(n_bodies + 1):
+            j = first if step == 0 else step - 1
+            if j < 0 or (step > 0 and j == first):
+                continue
             if refused:
                 out[p, j] = math.inf
                 continue
-            capsule = j < ends.shape[0]
+            out[p, j] = _body_gap(layer, origin, cell, normal, poses[p], base[p], ends, radii, palm, plane, vertical,
+                                  j, stop[p], only_below[p])
+            if out[p, j] < stop[p]:
+                refused, first = True, j
+
+
+@njit(cache=True)
+def _body_gap(layer, origin, cell, normal, pose, base, ends, radii, palm, plane, vertical, j, stop, only_below):
+    """The least gap of body ``j`` (a capsule of ``ends``, or the palm after them) at ``pose`` over the map, its walk
+    ended at a gap below ``stop`` and skipping the cells that cannot bring it below ``only_below``."""
+    nx_, ny_, nz_ = normal[0], normal[1], normal[2]
+    x, y, c, s = pose[0], pose[1], math.cos(pose[2]), math.sin(pose[2])
+    capsule = j < ends.shape[0]
+    if capsule:
+        pts, r = ends[j], radii[j]
+    else:
+        pts, r = palm, 0.0
+    lo_x = lo_y = lowest = math.inf
+    hi_x = hi_y = -math.inf
+    for v in range(pts.shape[0]):
+        px, py = x + c * pts[v, 0] - s * pts[v, 1], y + s * pts[v, 0] + c * pts[v, 1]
+        lo_x, hi_x, lo_y, hi_y = min(lo_x, px), max(hi_x, px), min(lo_y, py), max(hi_y, py)
+        z = pts[v, 2] if capsule else plane[0] + plane[1] * pts[v, 0] + plane[2] * pts[v, 1]
+        lowest = min(lowest, nx_ * px + ny_ * py + nz_ * z + base - r)
+    c0 = int(math.floor((lo_x - r - origin[0]) / cell))
+    c1 = int(math.floor((hi_x + r - origin[0]) / cell))
+    r0 = int(math.floor((lo_y - r - origin[1]) / cell))
+    r1 = int(math.floor((hi_y + r - origin[1]) / cell))
+    least = math.inf
+    if capsule:  # start from the cell under the lower end: over a flat floor, the least gap at once
+        e = 0 if nz_ * pts[0, 2] + nx_ * (c * pts[0, 0] - s * pts[0, 1]) + ny_ * (s * pts[0, 0] + c * pts[0, 1]) \
+            <= nz_ * pts[1, 2] + nx_ * (c * pts[1, 0] - s * pts[1, 1]) + ny_ * (s * pts[1, 0] + c * pts[1, 1]) else 1
+        ex, ey = x + c * pts[e, 0] - s * pts[e, 1], y + s * pts[e, 0] + c * pts[e, 1]
+        least = _gap(layer, origin, cell, normal, int(math.floor((ey - origin[1]) / cell)),
+                     int(math.floor((ex - origin[0]) / cell)), x, y, c, s, pts, r, base, vertical)
+    for i in range(r0, r1 + 1):
+        if least < stop:
+            break
+        for k in range(c0, c1 + 1):
+            if lowest - _cell(layer, i, k) >= min(least, only_below):
+                continue
             if capsule:
-                pts, r = ends[j], radii[j]
+                least = min(least, _gap(layer, origin, cell, normal, i, k, x, y, c, s, pts, r, base, vertical))
             else:
-                pts, r = palm, 0.0
-            lo_x = lo_y = lowest = math.inf
-            hi_x = hi_y = -math.inf
-            for v in range(pts.shape[0]):
-                px, py = x + c * pts[v, 0] - s * pts[v, 1], y + s * pts[v, 0] + c * pts[v, 1]
-                lo_x, hi_x, lo_y, hi_y = min(lo_x, px), max(hi_x, px), min(lo_y, py), max(hi_y, py)
-                z = pts[v, 2] if capsule else plane[0] + plane[1] * pts[v, 0] + plane[2] * pts[v, 1]
-                lowest = min(lowest, nx_ * px + ny_ * py + nz_ * z + base[p] - r)
-            c0 = int(math.floor((lo_x - r - origin[0]) / cell))
-            c1 = int(math.floor((hi_x + r - origin[0]) / cell))
-            r0 = int(math.floor((lo_y - r - origin[1]) / cell))
-            r1 = int(math.floor((hi_y + r - origin[1]) / cell))
-            least = math.inf
-            if capsule:  # start from the cell under the lower end: over a flat floor, the least gap at once
-                e = 0 if nz_ * pts[0, 2] + nx_ * (c * pts[0, 0] - s * pts[0, 1]) + ny_ * (s * pts[0, 0] + c * pts[0, 1]) \
-                    <= nz_ * pts[1, 2] + nx_ * (c * pts[1, 0] - s * pts[1, 1]) + ny_ * (s * pts[1, 0] + c * pts[1, 1]) else 1
-                ex, ey = x + c * pts[e, 0] - s * pts[e, 1], y + s * pts[e, 0] + c * pts[e, 1]
-                least = _gap(layer, origin, cell, normal, int(math.floor((ey - origin[1]) / cell)),
-                             int(math.floor((ex - origin[0]) / cell)), x, y, c, s, pts, r, base[p], vertical)
-            for i in range(r0, r1 + 1):
-                if least < stop[p]:
-                    break
-                for k in range(c0, c1 + 1):
-                    if lowest - _cell(layer, i, k) >= min(least, only_below[p]):
-                        continue
-                    if capsule:
-                        least = min(least, _gap(layer, origin, cell, normal, i, k, x, y, c, s, pts, r, base[p], vertical))
-                    else:
-                        least = min(least, _palm_gap(layer, origin, cell, normal, i, k, x, y, c, s, pts, plane,
-                                                     base[p]))
-                    if least < stop[p]:
-                        break
-            out[p, j] = least
-            refused = least < stop[p]
+                least = min(least, _palm_gap(layer, origin, cell, normal, i, k, x, y, c, s, pts, plane, base))
+            if least < stop:
+                break
+    return least

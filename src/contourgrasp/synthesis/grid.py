@@ -134,13 +134,47 @@ def screen_grid(
     PoseEvaluation
         Of ``grid.poses(model.locus)``, without safeguards but the centring cost.
     """
+    poses, touches, tables, n_yaw = _first_touches(model, hand, grid, curvature, samples)
+    return _scored(model, hand, grid, poses, touches, tables, centring_gain, n_yaw)
+
+
+def screen_reaching(
+    model: EFD, hand: Hand, grid: SearchGrid, *, curvature: CurvatureMode = "paper", samples: int = tol.EFD_SAMPLES,
+    centring_gain: float = 0.0,
+) -> tuple[PoseEvaluation, bool]:
+    """:func:`screen_grid` of only the grid poses where at least ``hand.min_touching`` fingers touch.
+
+    Every other pose is infeasible whatever the rest (eq 3.41 needs that many fingers on the
+    object), and on a dense grid they are about nine poses in ten: the search scores only these.
+    Each kept pose's evaluation is the one :func:`screen_grid` gives it, bit for bit; they keep
+    the grid's order.
+
+    Returns
+    -------
+    screen : PoseEvaluation
+        Of the kept poses.
+    any_outside : bool
+        Whether any pose of the whole grid starts with every fingertip outside the contour (what a
+        search that finds no pose says first).
+    """
+    poses, touches, tables, _ = _first_touches(model, hand, grid, curvature, samples)
+    lam, start_inside = touches[0], touches[3]
+    kept = sum(column.astype(np.int64) for column in np.isfinite(lam).T) >= hand.min_touching
+    any_outside = bool((~start_inside).all(axis=1).any())
+    screen = _scored(model, hand, grid, poses[kept], tuple(a[kept] for a in touches), tables, centring_gain, None)
+    return screen, any_outside
+
+
+def _first_touches(model: EFD, hand: Hand, grid: SearchGrid, curvature: CurvatureMode, samples: int):
+    """The grid's poses (p, 3); per pose and finger the first touch on the EFD polygon, (lam, t, point,
+    start_inside) as the compiled kernel gives them; the curvature tables; the number of yaws."""
     xs, ys, yaws = grid.axes(model.locus)
     contour_t, contour = polygon(model, samples)
     arrays = hand_arrays(hand)
-    seg, n_f = arrays.segments, len(hand.fingers)
+    seg = arrays.segments
     lam, t, point, start_inside = grid_first_touch(
         contour, contour_t, model.T, xs, ys, yaws, seg.start, seg.end - seg.start, seg.finger, seg.lam0, arrays.first,
-        n_f, tol.PARALLEL,
+        len(hand.fingers), tol.PARALLEL,
     )
     # The paper's curvature jumps where the contour turns from convex to concave; its magnitude and
     # the turning direction r' x r'' do not, so they are tabulated and interpolated apart.
@@ -148,13 +182,20 @@ def screen_grid(
     d1, d2 = efd_model.evaluate_derivatives(model, table_t, (1, 2))
     turn = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
     magnitude = np.abs(efd_model.curvature_from_derivatives(d1, d2, model.T, curvature))
-    curv = interpolate_curvature(magnitude, turn, t, model.T)
+    return grid.poses(model.locus), (lam, t, point, start_inside), (magnitude, turn), len(yaws)
+
+
+def _scored(model: EFD, hand: Hand, grid: SearchGrid, poses, touches, tables, centring_gain: float,
+            n_yaw: int | None) -> PoseEvaluation:
+    """:func:`~contourgrasp.synthesis.cost.score` of ``poses`` from their first ``touches`` and the curvature
+    ``tables``; ``n_yaw`` as there."""
+    lam, t, point, start_inside = touches
+    curv = interpolate_curvature(*tables, t, model.T)
     touching = np.isfinite(lam)
-    poses = grid.poses(model.locus)
     n = len(poses)
     return score(hand, poses, touching, np.where(touching, lam, np.nan), t, point, curv, start_inside,
                  grid.d_min, np.ones(n, bool), np.full(n, np.nan), Safeguards(centring_gain=centring_gain),
-                 n_yaw=len(yaws), locus=model.locus)
+                 n_yaw=n_yaw, locus=model.locus)
 
 
 def distinct_best(result: PoseEvaluation, grid: SearchGrid, k: int, block: int = 512) -> list[int]:

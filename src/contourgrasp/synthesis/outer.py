@@ -9,7 +9,8 @@ A grid over x, y within ``d_max`` of the contour's locus (A0, C0) (eq 3.39-3.40,
 * every ``required`` finger touches, and at least ``hand.min_touching`` do.
 
 Its cost is that of :mod:`contourgrasp.synthesis.cost`. :func:`search` screens every grid pose
-(:func:`~contourgrasp.synthesis.grid.screen_grid`), then solves the cheapest candidates exactly
+(:func:`~contourgrasp.synthesis.grid.screen_reaching`: the first touches of all, the cost of those enough
+fingers reach), then solves the cheapest candidates exactly
 (:func:`~contourgrasp.synthesis.evaluate_poses`: polygon contacts compiled, then Newton onto the
 curve). Optionally (``refine=True``), :func:`~contourgrasp.synthesis.refine_poses` leaves the grid:
 a bounded compass search in (x, y, yaw) from the best distinct grid poses, on the exact cost and
@@ -39,7 +40,7 @@ from .cost import distance
 from .descent import (Descent, DescentCheck, blocked_by_obstacles, body_names, check_candidates, descent_feasible,
                       descends_clear)
 from .evaluate import concatenate, evaluate_poses
-from .grid import SearchGrid, distinct_best, screen_grid
+from .grid import SearchGrid, distinct_best, screen_reaching
 from .inner import closest_approach
 from .plan import Alternative, Cost, FingerContact, GraspPlan, PoseEvaluation, Refinement
 from .refine import refine_poses
@@ -250,8 +251,8 @@ def _search_outline(contour, *, hand: Hand, grid: SearchGrid, safeguards: Safegu
     fitted = time.perf_counter()
     fewest = _fewest_touching(hand) if small_objects else hand.min_touching
     counts = range(hand.min_touching, fewest - 1, -1)
-    screen = screen_grid(model, replace(hand, min_touching=fewest), grid, curvature=curvature,
-                         centring_gain=safeguards.centring_gain)
+    screen, any_outside = screen_reaching(model, replace(hand, min_touching=fewest), grid, curvature=curvature,
+                                          centring_gain=safeguards.centring_gain)
     touch_counts = sum(column.astype(np.int64) for column in screen.touching.T)  # np.count_nonzero(axis=1): 4x slower
     share = np.full(len(screen.poses), np.nan)  # the squeeze's balance per screened pose, filled as attempts need it
     searched = time.perf_counter()
@@ -265,7 +266,7 @@ def _search_outline(contour, *, hand: Hand, grid: SearchGrid, safeguards: Safegu
                 return _search_fitted(model, contour, replace(hand, min_touching=touching),
                                       _needing(screen, touch_counts, touching), grid, guards, descent,
                                       curvature=curvature, top_k=top_k, refine=refine,
-                                      times=(clock, fitted, searched), share=share)
+                                      times=(clock, fitted, searched), share=share, any_outside=any_outside)
             except NoFeasibleGrasp as err:  # kept without its traceback: through this frame that would make a
                 errors.append(err.with_traceback(None))  # cycle holding every screen until the gc runs
         return None
@@ -351,15 +352,18 @@ def _needing(screen: PoseEvaluation, counts: np.ndarray, touching: int) -> PoseE
 
 def _search_fitted(model: EFD, contour, hand: Hand, screen: PoseEvaluation, grid: SearchGrid,
                    safeguards: Safeguards, descent: Descent | None, *, curvature, top_k, refine,
-                   times, share) -> GraspPlan:
+                   times, share, any_outside: bool) -> GraspPlan:
     """:func:`search` for one ``hand.min_touching`` on a fitted model and its screened grid.
+
+    ``screen``: :func:`~contourgrasp.synthesis.grid.screen_reaching`'s poses (with ``any_outside``, its
+    answer for the whole grid).
 
     ``times``: the clock at the search's start, after the fit and after the screen (``timing_ms``'s
     ``exact`` includes earlier counts' exact evaluations). ``share``: see :func:`_screened_share`.
     """
     clock, fitted, searched = times
     if not screen.feasible.any():
-        raise _no_pose(screen, hand, grid)
+        raise _no_pose(screen, hand, grid, any_outside)
     result = _reevaluate_best(model, hand, screen, max(tol.REFINE_CANDIDATES, 4 * top_k), curvature, grid.d_min,
                               safeguards, descent, share)
     ranked = distinct_best(result, grid, top_k)
@@ -400,7 +404,7 @@ def _search_fitted(model: EFD, contour, hand: Hand, screen: PoseEvaluation, grid
         curvature_mode=curvature,
         grid=grid,
         alternatives=tuple(Alternative(tuple(map(float, result.poses[i])), _cost(result, i)) for i in ranked),
-        grid_size=len(screen.poses),
+        grid_size=math.prod(grid.shape),
         feasible_poses=int(screen.feasible.sum()),
         timing_ms=timing,
         refinement=refinement,
@@ -582,10 +586,11 @@ def _cost(result: PoseEvaluation, i: int) -> Cost:
     )
 
 
-def _no_pose(result: PoseEvaluation, hand: Hand, grid: SearchGrid) -> NoFeasibleGrasp:
-    """The failure naming the first constraint that leaves no pose standing (:class:`_OutOfReach` for reach)."""
-    n = len(result.poses)
-    if not result.starts_outside.any():
+def _no_pose(result: PoseEvaluation, hand: Hand, grid: SearchGrid, any_outside: bool) -> NoFeasibleGrasp:
+    """The failure naming the first constraint that leaves no pose of the ``grid`` standing (:class:`_OutOfReach`
+    for reach); ``result``: its poses where enough fingers touch, ``any_outside``: some pose of it starts outside."""
+    n = math.prod(grid.shape)
+    if not any_outside:
         return NoFeasibleGrasp(f"no pose keeps every fingertip outside the object ({n} poses tried): "
                                "the object is larger than the hand")
     reach = result.starts_outside & result.reaches
