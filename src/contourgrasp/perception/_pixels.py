@@ -23,7 +23,9 @@ def components(mask):
     and each label's pixels.
 
     OpenCV's statistics (every label's box and centroid, the background's too) cost several
-    times the labelling; where only areas are needed they are one bincount.
+    times the labelling; where only areas are needed they are one bincount. Both run on the
+    mask's bounding box only (an object is a few percent of a frame), its corner moved to an even
+    row and column: OpenCV scans 2 x 2 blocks, so the labels are numbered as on the whole image.
 
     Examples
     --------
@@ -32,8 +34,16 @@ def components(mask):
     >>> int(count), areas.tolist()
     (3, [19, 1, 4])
     """
-    count, labels = cv2.connectedComponents(mask.astype(np.uint8), connectivity=8)
-    return count, labels, np.bincount(labels.ravel(), minlength=count)
+    mask = np.asarray(mask, dtype=bool)
+    labels = np.zeros(mask.shape, dtype=np.int32)
+    if not mask.any():
+        return 1, labels, np.array([mask.size])
+    rows, cols = grown_box(mask, 0)
+    box = slice(rows.start - rows.start % 2, rows.stop), slice(cols.start - cols.start % 2, cols.stop)
+    count, labels[box] = cv2.connectedComponents(mask[box].astype(np.uint8), connectivity=8)
+    areas = np.bincount(labels[box].ravel(), minlength=count)
+    areas[0] += mask.size - labels[box].size
+    return count, labels, areas
 
 
 def disc(radius):
