@@ -333,6 +333,21 @@ def _later_chords(lam, t, point, q, q_t, period, e, xs, ys, iyaw, nyaw, chords, 
 
 
 @njit(cache=True)
+def touch_counts(lam, inside):
+    """Per pose the fingers that touch (``lam`` (p, f) finite), and whether some pose starts with no fingertip
+    ``inside`` (p, f): one pass where numpy's row reductions of a (p, 5) array walk it five times."""
+    counts = np.zeros(lam.shape[0], np.int64)
+    any_outside = False
+    for p in range(lam.shape[0]):
+        starts_inside = False
+        for f in range(lam.shape[1]):
+            counts[p] += math.isfinite(lam[p, f])
+            starts_inside |= inside[p, f]
+        any_outside |= not starts_inside
+    return counts, any_outside
+
+
+@njit(cache=True)
 def interpolate_curvature(magnitude, turn, t, period):
     """Curvature at EFD parameters t (p, f) from tables over [0, period) (NaN stays NaN).
 

