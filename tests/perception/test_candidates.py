@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import cv2
 import numpy as np
 import pytest
 
@@ -450,3 +451,37 @@ def test_a_post_that_closes_a_bins_ring_in_front_of_its_wall_is_split_from_it():
     assert split_at_depth_steps(above, depth, 100, focal=focal)[0] == 1  # no step between them: one surface
     above, depth = ring_with_a_post(60, 0.55)  # a 50 px hole, 0.0036 m^2: a handle's, not a floor
     assert split_at_depth_steps(above, depth, 100, focal=focal)[0] == 1
+
+
+def test_regions_without_a_split_are_opencvs_on_the_whole_image():
+    """Labelled on the raised pixels' box, the labels, boxes and centroids are OpenCV's on the whole image, to the bit."""
+    from contourgrasp.perception.candidates import split_at_depth_steps
+
+    rng = np.random.default_rng(4)
+    for _ in range(100):
+        above = np.zeros((97, 131), bool)
+        for _ in range(rng.integers(1, 6)):
+            r, c = rng.integers(1, 97), rng.integers(1, 131)
+            block = above[r:r + rng.integers(1, 40), c:c + rng.integers(1, 40)]
+            block[...] = rng.random(block.shape) < 0.8
+        count, labels, stats, centroids = split_at_depth_steps(above, np.full(above.shape, 0.6), 10)
+        n, whole, whole_stats, whole_centroids = cv2.connectedComponentsWithStats(above.astype(np.uint8),
+                                                                                  connectivity=8)
+        assert count == n - 1
+        np.testing.assert_array_equal(labels, whole)
+        np.testing.assert_array_equal(stats[1:], whole_stats[1:])
+        np.testing.assert_array_equal(centroids[1:], whole_centroids[1:])
+
+
+def test_a_split_region_moves_with_the_image():
+    """The split of the post from a bin's ring, the picture shifted by (7, 5) px: the same regions, shifted."""
+    from contourgrasp.perception.candidates import split_at_depth_steps
+
+    above, depth = ring_with_a_post(160, 0.55)
+    count, labels, stats, centroids = split_at_depth_steps(above, depth, 100, focal=(500.0, 500.0))
+    moved = [np.pad(a, ((5, 0), (7, 0)), constant_values=fill) for a, fill in ((above, False), (depth, 0.6))]
+    count_moved, labels_moved, stats_moved, centroids_moved = split_at_depth_steps(*moved, 100, focal=(500.0, 500.0))
+    assert count == count_moved == 2
+    np.testing.assert_array_equal(labels_moved[5:, 7:], labels)
+    np.testing.assert_array_equal(stats_moved[1:], stats[1:] + [7, 5, 0, 0, 0])
+    np.testing.assert_allclose(centroids_moved[1:], centroids[1:] + [7, 5], rtol=0, atol=1e-9)

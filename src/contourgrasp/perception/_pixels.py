@@ -24,8 +24,7 @@ def components(mask):
 
     OpenCV's statistics (every label's box and centroid, the background's too) cost several
     times the labelling; where only areas are needed they are one bincount. Both run on the
-    mask's bounding box only (an object is a few percent of a frame), its corner moved to an even
-    row and column: OpenCV scans 2 x 2 blocks, so the labels are numbered as on the whole image.
+    mask's :func:`even_box` only (an object is a few percent of a frame).
 
     Examples
     --------
@@ -38,12 +37,21 @@ def components(mask):
     labels = np.zeros(mask.shape, dtype=np.int32)
     if not mask.any():
         return 1, labels, np.array([mask.size])
-    rows, cols = grown_box(mask, 0)
-    box = slice(rows.start - rows.start % 2, rows.stop), slice(cols.start - cols.start % 2, cols.stop)
+    box = even_box(mask)
     count, labels[box] = cv2.connectedComponents(mask[box].astype(np.uint8), connectivity=8)
     areas = np.bincount(labels[box].ravel(), minlength=count)
     areas[0] += mask.size - labels[box].size
     return count, labels, areas
+
+
+def even_box(mask):
+    """(rows, cols) slices of ``mask``'s bounding box, not empty, its corner moved to an even row and column.
+
+    OpenCV's connected components scan 2 x 2 blocks and number the labels in that scan's order, so
+    labelled on this box a mask's labels are numbered as on the whole image (tested).
+    """
+    rows, cols = grown_box(mask, 0)
+    return slice(rows.start - rows.start % 2, rows.stop), slice(cols.start - cols.start % 2, cols.stop)
 
 
 def disc(radius):

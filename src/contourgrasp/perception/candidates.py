@@ -34,7 +34,7 @@ from ..errors import PerceptionError, SegmentationError
 from ..tolerances import (CANDIDATE_DEPTH_STEP, CONTAINER_FLOOR_AREA, ENCLOSED_FRACTION, FLAT_HEIGHT_SIGMAS,
                           LOW_PART_REACH_PX, LOW_PART_STEP, MIN_AREA_PX, MIN_HEIGHT, SENSOR_RANGE,
                           SIMILAR_SIZE)
-from ._pixels import check_pixel, connected_to
+from ._pixels import check_pixel, connected_to, even_box
 from .camera import Intrinsics, as_depth, check_intrinsics, valid_depth
 from .region import mask_contour, touching_regions
 from .segment_depth import open_specks, raised_pixels
@@ -183,7 +183,9 @@ def split_at_depth_steps(above, depth, min_area_px: int, *, focal=None):
     Returns
     -------
     count, labels, stats, centroids
-        As :func:`cv2.connectedComponentsWithStats` (``count`` without the background).
+        As :func:`cv2.connectedComponentsWithStats` (``count`` without the background), computed on
+        ``above``'s bounding box (:func:`~contourgrasp.perception._pixels.even_box`): the labels, boxes
+        and centroids are the whole image's, the background's row describes the box's background.
 
     Examples
     --------
@@ -200,6 +202,19 @@ def split_at_depth_steps(above, depth, min_area_px: int, *, focal=None):
     >>> split_at_depth_steps(side, step, 100)[0]
     1
     """
+    labels = np.zeros(above.shape, dtype=np.int32)
+    if not above.any():
+        return 0, labels, np.array([[0, 0, above.shape[1], above.shape[0], above.size]], dtype=np.int32), \
+            np.array([[(above.shape[1] - 1) / 2, (above.shape[0] - 1) / 2]])
+    box = even_box(above)
+    count, labels[box], stats, centroids = _split_in(above[box], depth[box], min_area_px, focal,
+                                                     (box[1].start, box[0].start))
+    return count, labels, stats, centroids
+
+
+def _split_in(above, depth, min_area_px, focal, origin):
+    """:func:`split_at_depth_steps` on a box of the image whose corner is at ``origin`` (x, y): the labels on the
+    box, the boxes and centroids in the image (the sums of the pixels' image coordinates, as OpenCV's)."""
     step = np.zeros_like(above)
     down = above[:-1] & above[1:] & (np.abs(depth[1:] - depth[:-1]) > CANDIDATE_DEPTH_STEP)
     right = above[:, :-1] & above[:, 1:] & (np.abs(depth[:, 1:] - depth[:, :-1]) > CANDIDATE_DEPTH_STEP)
@@ -208,8 +223,9 @@ def split_at_depth_steps(above, depth, min_area_px: int, *, focal=None):
     step[:, :-1] |= right
     step[:, 1:] |= right
     count, regions, boxes, centroids = cv2.connectedComponentsWithStats(above.astype(np.uint8), connectivity=8)
+    whole = count - 1, regions, *_in_image(boxes, centroids, origin)
     if not step.any():
-        return count - 1, regions, boxes, centroids
+        return whole
     _, pieces, stats = cv2.connectedComponentsWithStats((above & ~step).astype(np.uint8), connectivity=8)[:3]
     keep = (stats[:, cv2.CC_STAT_AREA] >= min_area_px)[pieces] & (pieces > 0)
     labels = None
@@ -222,20 +238,35 @@ def split_at_depth_steps(above, depth, min_area_px: int, *, focal=None):
             rows, cols = ndimage.distance_transform_edt(~seeds, return_distances=False, return_indices=True)
             labels[box][inside] = pieces[box][rows[inside], cols[inside]]
     if labels is None:
-        return count - 1, regions, boxes, centroids
+        return whole
     values = np.unique(labels[above])
     compact = np.zeros(labels.shape, dtype=np.int32)
     compact[above] = np.searchsorted(values, labels[above]) + 1
     count = len(values)
     rows, cols = np.indices(labels.shape)
+    rows, cols = rows + origin[1], cols + origin[0]
     area = np.bincount(compact.ravel(), minlength=count + 1)
     centroids = np.stack([np.bincount(compact.ravel(), cols.ravel(), count + 1),
                           np.bincount(compact.ravel(), rows.ravel(), count + 1)], axis=1) / np.maximum(area, 1)[:, None]
     stats = np.zeros((count + 1, 5), dtype=np.int32)
     for i, found in enumerate(ndimage.find_objects(compact), start=1):
-        stats[i] = (found[1].start, found[0].start, found[1].stop - found[1].start, found[0].stop - found[0].start,
-                    area[i])
+        stats[i] = (found[1].start + origin[0], found[0].start + origin[1], found[1].stop - found[1].start,
+                    found[0].stop - found[0].start, area[i])
     return count, compact, stats, centroids
+
+
+def _in_image(boxes, centroids, origin):
+    """OpenCV's ``boxes`` and ``centroids`` of a box at ``origin`` (x, y), in the image.
+
+    A centroid is an integer sum over the area, which the box's centroid times the area gives back
+    exactly; shifted, it is divided as OpenCV divides it, so the image's centroids are its own to the bit.
+    """
+    boxes = boxes.copy()
+    boxes[:, 0] += origin[0]
+    boxes[:, 1] += origin[1]
+    area = boxes[:, cv2.CC_STAT_AREA].astype(float)[:, None]
+    sums = np.rint(centroids * area) + area * np.asarray(origin, dtype=float)
+    return boxes, sums / np.maximum(area, 1)
 
 
 def _holds_floor(region, depth, focal) -> bool:
