@@ -22,7 +22,7 @@ from .. import validation
 from ..errors import PerceptionError
 from ..tolerances import APPROACH_MEDIAN_PX, MAX_HOLE_PX, SENSOR_RANGE
 from ._frame import memoised
-from ._pixels import pixel_box
+from ._pixels import even_box, pixel_box
 
 
 @dataclass(frozen=True)
@@ -165,7 +165,7 @@ def fill_depth_holes(depth, *, max_hole_px: int = MAX_HOLE_PX) -> tuple[np.ndarr
         missing = ~np.isfinite(d) | (d <= 0)
     if not missing.any() or missing.all() or max_hole_px == 0:
         return d.copy(), 0
-    _, labels, stats, _ = cv2.connectedComponentsWithStats(missing.astype(np.uint8), connectivity=8)
+    labels, stats = _holes(missing)
     small = stats[:, cv2.CC_STAT_AREA] <= max_hole_px
     small[0] = False
     if not small.any():
@@ -175,6 +175,17 @@ def fill_depth_holes(depth, *, max_hole_px: int = MAX_HOLE_PX) -> tuple[np.ndarr
         _, (rows, cols) = ndimage.distance_transform_edt(missing[box], return_indices=True)
         out[box][fill] = d[box][rows[fill], cols[fill]]
     return out, int(stats[small, cv2.CC_STAT_AREA].sum())
+
+
+def _holes(missing):
+    """(labels, stats) of the 8-connected regions of ``missing``, as OpenCV's on the whole image (the
+    background's row aside), labelled on their :func:`~contourgrasp.perception._pixels.even_box`."""
+    box = even_box(missing)
+    labels = np.zeros(missing.shape, dtype=np.int32)
+    _, labels[box], stats, _ = cv2.connectedComponentsWithStats(missing[box].astype(np.uint8), connectivity=8)
+    stats[:, cv2.CC_STAT_LEFT] += box[1].start
+    stats[:, cv2.CC_STAT_TOP] += box[0].start
+    return labels, stats
 
 
 #: What one more distance transform costs beyond its pixels, in pixels (about 30 us against 60 ns a
