@@ -117,7 +117,7 @@ def clearances(layer, origin, cell, normal, poses, base, ends, radii, palm, plan
     (its outline (k, 2) and underside plane (3,)); a pose's walk ends at a gap below its ``stop`` (p,), and skips
     the cells that cannot bring a gap below its ``only_below`` (p,).
 
-    A pose's walk starts with the body that ended the last refused pose's: neighbouring candidates tend to
+    A pose's walk starts with the body that refused the last refused pose: neighbouring candidates tend to
     strike with the same body, and a refused pose's other bodies need no walk (they are +inf either way).
     """
     n_bodies = ends.shape[0] + 1
