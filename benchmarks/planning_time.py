@@ -1,10 +1,11 @@
-"""Planning time per frame (issue 6: under 100 ms): `plan_grasp` on simulated frames, per planner.
+"""Planning time per frame (issues 6 and 16: under 100 ms): `plan_grasp` on simulated frames, per planner.
 
 One simulated RGB-D frame per thesis object (seed 3 unless ``--seed``, depth noise on), planned with
 the `five-finger-linear` hand: perception, synthesis and the 6-DoF pose, exactly
 what a bench trial's planner does. Prints, per planner and object, the median
 wall time of 5 runs (``--runs``) after a warm-up, the slowest of them, and the
-synthesis's share (its ``timing_ms.total``). One thread (set before numpy is imported). ``--cpu``
+synthesis's share (its ``timing_ms.total``), then a line per planner: the slowest median and plan, the
+median of the medians, how many exceed 100 ms. One thread (set before numpy is imported). ``--cpu``
 times the process's CPU time instead of the wall clock (steadier on a
 loaded machine); ``--real`` also plans the real frames with hand-made masks
 (``benchmarks/segmentation.py``'s, in ``../shared/data``), perception
@@ -98,11 +99,28 @@ def main() -> None:
           f"its timing_ms.total, wall time)\n")
     print("| planner | " + " | ".join(frames) + " |")
     print("|---|" + "---:|" * len(frames))
+    summaries = []
     for planner in args.planners.split(","):
         cells = [frame_times(planner, frame, clock, args.runs) for frame in frames.values()]
         print(f"| {planner} | " + " | ".join(f"{w:.0f} ms (slowest {m:.0f}; synthesis {s:.0f})" for w, m, s in cells)
               + " |")
+        summaries.append(summary(planner, dict(zip(frames, cells))))
+    print("", *summaries, sep="\n")
     print(f"\nload average at end: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
+
+
+def summary(planner: str, cells: dict, budget: float = 100.0) -> str:
+    """One line per planner: the slowest median and plan, the median of the medians, the frames over ``budget`` ms."""
+    planned = {name: cell for name, cell in cells.items() if not math.isnan(cell[0])}
+    if not planned:
+        return f"{planner}: no frame planned"
+    medians = {name: cell[0] for name, cell in planned.items()}
+    slowest = {name: cell[1] for name, cell in planned.items()}
+    worst, worst_plan = max(medians, key=medians.get), max(slowest, key=slowest.get)
+    return (f"{planner}: slowest median {medians[worst]:.0f} ms ({worst}), median of the {len(planned)} medians "
+            f"{statistics.median(medians.values()):.0f} ms, slowest plan {slowest[worst_plan]:.0f} ms ({worst_plan}); "
+            f"over {budget:.0f} ms: {sum(v > budget for v in medians.values())} medians, "
+            f"{sum(v > budget for v in slowest.values())} slowest plans")
 
 
 if __name__ == "__main__":
