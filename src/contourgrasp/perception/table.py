@@ -115,7 +115,7 @@ def fit_plane(
     sample = validation.integer("sample", sample, 3, error=PerceptionError)
     seed = validation.integer("seed", seed, 0, error=PerceptionError)
     max_tilt = validation.finite("max_tilt", max_tilt, error=PerceptionError)
-    finite = np.all(np.isfinite(p), axis=1)
+    finite = np.isfinite(p[:, 0]) & np.isfinite(p[:, 1]) & np.isfinite(p[:, 2])  # np.all(axis=1) walks rows: 5x slower
     cloud = p[finite]
     if len(cloud) < 3:
         raise SegmentationError("no-plane", f"no table plane: only {len(cloud)} valid depth points")
@@ -127,7 +127,9 @@ def fit_plane(
             f"no table plane: no plane through the depth points faces the camera within {math.degrees(max_tilt):.0f} deg",
         )
     voters = cloud[rng.choice(len(cloud), size=sample, replace=False)] if len(cloud) > sample else cloud
-    best = _best_candidate(cloud, normals, offsets, np.abs(normals @ voters.T + offsets[:, None]) < threshold, threshold)
+    distance = normals @ voters.T  # (candidates, sample): in place, the same arithmetic without two temporaries
+    distance += offsets[:, None]
+    best = _best_candidate(cloud, normals, offsets, np.abs(distance, out=distance) < threshold, threshold)
     normal, offset = normals[best], offsets[best]
     for _ in range(2):
         inliers = np.abs(cloud @ normal + offset) < threshold
