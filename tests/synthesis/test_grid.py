@@ -43,8 +43,9 @@ def test_the_reaching_screen_is_the_full_screen_where_enough_fingers_touch(touch
     model = efd.fit(cg.example_contour("stone1"))
     grid = synthesis.SearchGrid(xy_step=0.03, yaw_step=math.radians(7))
     full = synthesis.screen_grid(model, hand, grid)
-    reaching, any_outside = synthesis.screen_reaching(model, hand, grid)
+    reaching, counts, any_outside = synthesis.screen_reaching(model, hand, grid)
     kept = full.touching.sum(axis=1) >= touching
+    np.testing.assert_array_equal(counts, full.touching.sum(axis=1)[kept])
     assert 0 < kept.sum() < len(full.poses)
     for field in dataclasses.fields(full):
         np.testing.assert_array_equal(getattr(reaching, field.name), getattr(full, field.name)[kept], err_msg=field.name)

@@ -35,8 +35,6 @@ def components(mask):
     """
     mask = np.asarray(mask, dtype=bool)
     labels = np.zeros(mask.shape, dtype=np.int32)
-    if not mask.any():
-        return 1, labels, np.array([mask.size])
     box = even_box(mask)
     count, labels[box] = cv2.connectedComponents(mask[box].astype(np.uint8), connectivity=8)
     areas = np.bincount(labels[box].ravel(), minlength=count)
@@ -45,11 +43,14 @@ def components(mask):
 
 
 def even_box(mask):
-    """(rows, cols) slices of ``mask``'s bounding box, not empty, its corner moved to an even row and column.
+    """(rows, cols) slices of ``mask``'s bounding box, its corner moved to an even row and column; the whole
+    image for an empty mask.
 
     OpenCV's connected components scan 2 x 2 blocks and number the labels in that scan's order, so
     labelled on this box a mask's labels are numbered as on the whole image (tested).
     """
+    if not mask.any():
+        return slice(0, mask.shape[0]), slice(0, mask.shape[1])
     rows, cols = grown_box(mask, 0)
     return slice(rows.start - rows.start % 2, rows.stop), slice(cols.start - cols.start % 2, cols.stop)
 

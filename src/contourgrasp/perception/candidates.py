@@ -203,9 +203,6 @@ def split_at_depth_steps(above, depth, min_area_px: int, *, focal=None):
     1
     """
     labels = np.zeros(above.shape, dtype=np.int32)
-    if not above.any():
-        return 0, labels, np.array([[0, 0, above.shape[1], above.shape[0], above.size]], dtype=np.int32), \
-            np.array([[(above.shape[1] - 1) / 2, (above.shape[0] - 1) / 2]])
     box = even_box(above)
     count, labels[box], stats, centroids = _split_in(above[box], depth[box], min_area_px, focal,
                                                      (box[1].start, box[0].start))

@@ -141,7 +141,7 @@ def screen_grid(
 def screen_reaching(
     model: EFD, hand: Hand, grid: SearchGrid, *, curvature: CurvatureMode = "paper", samples: int = tol.EFD_SAMPLES,
     centring_gain: float = 0.0,
-) -> tuple[PoseEvaluation, bool]:
+) -> tuple[PoseEvaluation, np.ndarray, bool]:
     """:func:`screen_grid` of only the grid poses where at least ``hand.min_touching`` fingers touch.
 
     Every other pose is infeasible whatever the rest (eq 3.41 needs that many fingers on the
@@ -153,6 +153,8 @@ def screen_reaching(
     -------
     screen : PoseEvaluation
         Of the kept poses.
+    touching : (p,) int
+        The fingers that touch at each kept pose (``screen.touching`` counted).
     any_outside : bool
         Whether any pose of the whole grid starts with every fingertip outside the contour (what a
         search that finds no pose says first).
@@ -162,7 +164,7 @@ def screen_reaching(
     kept = np.flatnonzero(counts >= hand.min_touching)  # np.take of these rows: 5x faster than boolean indexing
     screen = _scored(model, hand, grid, poses[kept], tuple(np.take(a, kept, axis=0) for a in touches), tables,
                      centring_gain, None)
-    return screen, bool(any_outside)
+    return screen, counts[kept], bool(any_outside)
 
 
 def _first_touches(model: EFD, hand: Hand, grid: SearchGrid, curvature: CurvatureMode, samples: int):

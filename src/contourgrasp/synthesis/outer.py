@@ -251,9 +251,8 @@ def _search_outline(contour, *, hand: Hand, grid: SearchGrid, safeguards: Safegu
     fitted = time.perf_counter()
     fewest = _fewest_touching(hand) if small_objects else hand.min_touching
     counts = range(hand.min_touching, fewest - 1, -1)
-    screen, any_outside = screen_reaching(model, replace(hand, min_touching=fewest), grid, curvature=curvature,
-                                          centring_gain=safeguards.centring_gain)
-    touch_counts = sum(column.astype(np.int64) for column in screen.touching.T)  # np.count_nonzero(axis=1): 4x slower
+    screen, touch_counts, any_outside = screen_reaching(model, replace(hand, min_touching=fewest), grid,
+                                                        curvature=curvature, centring_gain=safeguards.centring_gain)
     share = np.full(len(screen.poses), np.nan)  # the squeeze's balance per screened pose, filled as attempts need it
     searched = time.perf_counter()
     errors = []
