@@ -185,6 +185,19 @@ RULES = {
 }
 
 
+def run_frames(frame_records, tasks: list, workers: int, json_path: str | None) -> list[dict]:
+    """Every task's records (``frame_records(task) -> list of dict``) on ``workers`` processes, in task order,
+    written to ``json_path`` when given; prints the time taken."""
+    started = time.perf_counter()
+    with multiprocessing.get_context("spawn").Pool(workers) as pool:
+        records = [r for rows in pool.imap(frame_records, tasks) for r in rows]
+    if json_path:
+        with open(json_path, "w") as out:
+            json.dump(records, out)
+    print(f"{len(tasks)} frames in {time.perf_counter() - started:.0f} s\n")
+    return records
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--objects", default="ycb-train", help="as the bench's --objects (sets or names)")
@@ -200,13 +213,7 @@ def main() -> None:
     seeds = [int(s) for s in args.seeds.split(",")]
     tasks = [(name, seed, args.screened, args.per_class, args.hand_model)
              for names in sets.values() for name in names for seed in seeds]
-    started = time.perf_counter()
-    with multiprocessing.get_context("spawn").Pool(args.workers) as pool:
-        records = [r for rows in pool.imap(frame, tasks) for r in rows]
-    if args.json:
-        with open(args.json, "w") as out:
-            json.dump(records, out)
-    print(f"{len(tasks)} frames in {time.perf_counter() - started:.0f} s\n")
+    records = run_frames(frame, tasks, args.workers, args.json)
     for part, names in sets.items():
         print(f"## {part}\n")
         print("\n".join(table([r for r in records if r["object"] in names])) + "\n")
