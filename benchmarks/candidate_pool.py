@@ -60,6 +60,8 @@ from contourgrasp.synthesis.outer import _fewest_touching, _screened_share
 from contourgrasp.synthesis.safeguards import Safeguards
 
 HAND = "five-finger-linear"
+#: The cheapest screened poses evaluated exactly per frame (``--screened``'s default).
+SCREENED = 1500
 #: Just below 1: the safeguards compute each pose's imbalance without requiring any balance.
 UNBALANCED = 1.0 - 1e-9
 
@@ -202,7 +204,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--objects", default="ycb-train", help="as the bench's --objects (sets or names)")
     parser.add_argument("--seeds", default="0,1,2,3,4", help="comma-separated scene seeds (the bench's trial t: seed t)")
-    parser.add_argument("--screened", type=int, default=1500, help="cheapest screened poses evaluated exactly")
+    parser.add_argument("--screened", type=int, default=SCREENED, help="cheapest screened poses evaluated exactly")
     parser.add_argument("--per-class", type=int, default=3, help="distinct poses executed per class")
     parser.add_argument("--hand-model", default=None, help="a bundled model (inspire, jaco-three-finger), "
                         "simulated as itself and planned with its derived hand file, as the bench's --hand-model")

@@ -108,7 +108,7 @@ def frame(task: tuple) -> list[dict]:
     except (NoFeasibleGrasp, InputError):
         return [base | {"class": "no plan", "success": False, "predicted": False}]
     executed = [(planned.plan.pose, planned.grasp_height, "planned")]
-    executed += candidate_pool._classes(planned, hand, options, 1500, per_class)
+    executed += candidate_pool._classes(planned, hand, options, candidate_pool.SCREENED, per_class)
     stand_in = perceived_object(planned, scene.camera, block=block, density=density)
     perceived, perceived_state = _settled(stand_in, scene)
     records = []
