@@ -55,6 +55,20 @@ def even_box(mask):
     return slice(rows.start - rows.start % 2, rows.stop), slice(cols.start - cols.start % 2, cols.stop)
 
 
+def stats_in_image(boxes, centroids, origin):
+    """OpenCV's ``boxes`` and ``centroids`` of a box at ``origin`` (x, y), in the image.
+
+    A centroid is an integer sum over the area, which the box's centroid times the area gives back
+    exactly; shifted, it is divided as OpenCV divides it, so the image's centroids are its own to the bit.
+    """
+    boxes = boxes.copy()
+    boxes[:, cv2.CC_STAT_LEFT] += origin[0]
+    boxes[:, cv2.CC_STAT_TOP] += origin[1]
+    area = boxes[:, cv2.CC_STAT_AREA].astype(float)[:, None]
+    sums = np.rint(centroids * area) + area * np.asarray(origin, dtype=float)
+    return boxes, sums / np.maximum(area, 1)
+
+
 def disc(radius):
     """OpenCV's elliptic structuring element of ``radius`` px."""
     return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 1, 2 * radius + 1))

@@ -22,7 +22,7 @@ from .. import validation
 from ..errors import PerceptionError
 from ..tolerances import APPROACH_MEDIAN_PX, MAX_HOLE_PX, SENSOR_RANGE
 from ._frame import memoised
-from ._pixels import even_box, pixel_box
+from ._pixels import even_box, pixel_box, stats_in_image
 
 
 @dataclass(frozen=True)
@@ -182,10 +182,8 @@ def _holes(missing):
     background's row aside), labelled on their :func:`~contourgrasp.perception._pixels.even_box`."""
     box = even_box(missing)
     labels = np.zeros(missing.shape, dtype=np.int32)
-    _, labels[box], stats, _ = cv2.connectedComponentsWithStats(missing[box].astype(np.uint8), connectivity=8)
-    stats[:, cv2.CC_STAT_LEFT] += box[1].start
-    stats[:, cv2.CC_STAT_TOP] += box[0].start
-    return labels, stats
+    _, labels[box], stats, centroids = cv2.connectedComponentsWithStats(missing[box].astype(np.uint8), connectivity=8)
+    return labels, stats_in_image(stats, centroids, (box[1].start, box[0].start))[0]
 
 
 #: What one more distance transform costs beyond its pixels, in pixels (about 30 us against 60 ns a

@@ -34,7 +34,7 @@ from ..errors import PerceptionError, SegmentationError
 from ..tolerances import (CANDIDATE_DEPTH_STEP, CONTAINER_FLOOR_AREA, ENCLOSED_FRACTION, FLAT_HEIGHT_SIGMAS,
                           LOW_PART_REACH_PX, LOW_PART_STEP, MIN_AREA_PX, MIN_HEIGHT, SENSOR_RANGE,
                           SIMILAR_SIZE)
-from ._pixels import check_pixel, connected_to, even_box
+from ._pixels import check_pixel, connected_to, even_box, stats_in_image
 from .camera import Intrinsics, as_depth, check_intrinsics, valid_depth
 from .region import mask_contour, touching_regions
 from .segment_depth import open_specks, raised_pixels
@@ -220,7 +220,7 @@ def _split_in(above, depth, min_area_px, focal, origin):
     step[:, :-1] |= right
     step[:, 1:] |= right
     count, regions, boxes, centroids = cv2.connectedComponentsWithStats(above.astype(np.uint8), connectivity=8)
-    whole = count - 1, regions, *_in_image(boxes, centroids, origin)
+    whole = count - 1, regions, *stats_in_image(boxes, centroids, origin)
     if not step.any():
         return whole
     _, pieces, stats = cv2.connectedComponentsWithStats((above & ~step).astype(np.uint8), connectivity=8)[:3]
@@ -250,20 +250,6 @@ def _split_in(above, depth, min_area_px, focal, origin):
         stats[i] = (found[1].start + origin[0], found[0].start + origin[1], found[1].stop - found[1].start,
                     found[0].stop - found[0].start, area[i])
     return count, compact, stats, centroids
-
-
-def _in_image(boxes, centroids, origin):
-    """OpenCV's ``boxes`` and ``centroids`` of a box at ``origin`` (x, y), in the image.
-
-    A centroid is an integer sum over the area, which the box's centroid times the area gives back
-    exactly; shifted, it is divided as OpenCV divides it, so the image's centroids are its own to the bit.
-    """
-    boxes = boxes.copy()
-    boxes[:, 0] += origin[0]
-    boxes[:, 1] += origin[1]
-    area = boxes[:, cv2.CC_STAT_AREA].astype(float)[:, None]
-    sums = np.rint(centroids * area) + area * np.asarray(origin, dtype=float)
-    return boxes, sums / np.maximum(area, 1)
 
 
 def _holds_floor(region, depth, focal) -> bool:
