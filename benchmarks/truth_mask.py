@@ -28,11 +28,12 @@ from contourgrasp.sim.ycb import OBJECT_SETS, load_object, object_names
 HAND = "five-finger-linear"
 
 
+#: The library's reading of a user's mask, which :func:`trial_pair` replaces by :func:`_as_footprint`.
+_user_mask = perception.segment_from_mask
+
+
 def _as_footprint(mask, **options):
     return dataclasses.replace(_user_mask(mask, **options), on_table=True)
-
-
-_user_mask = perception.segment_from_mask
 
 
 def trial_pair(task: tuple[str, str, int, str]) -> tuple[str, int, dict]:
