@@ -191,6 +191,7 @@ def plan_args(tmp_path, **overrides):
     ("millimetres as float", 2, "median depth 664 m: probably millimetres"),
     ("scaled twice", 2, "closer than a depth camera measures"),
     ("integer millimetres at scale 1", 2, "median depth 664 m: probably millimetres (scale 0.001); check --depth-scale"),
+    ("empty mask", 2, "empty.png: the mask is empty"),
 ])
 def test_plan_bad_inputs(tmp_path, capsys, case, code, message):
     overrides = {}
@@ -219,6 +220,9 @@ def test_plan_bad_inputs(tmp_path, capsys, case, code, message):
     elif case == "integer millimetres at scale 1":  # a 16-bit PNG in millimetres, read as meters
         cv2.imwrite(str(tmp_path / "mm.png"), np.round(np.load(FRAME / "depth_0.npy") * 1e3).astype(np.uint16))
         overrides.update({"--depth": tmp_path / "mm.png", "--depth-scale": 1})
+    elif case == "empty mask":
+        cv2.imwrite(str(tmp_path / "empty.png"), np.zeros((480, 640), np.uint8))
+        overrides["--mask"] = tmp_path / "empty.png"
     before = set(tmp_path.iterdir())
     result = main(plan_args(tmp_path, **overrides))
     err = capsys.readouterr().err
@@ -292,7 +296,7 @@ def test_cli_refuses_an_absurd_approach_offset(tmp_path, capsys):
 
 
 def test_cli_mask_of_another_size_names_the_files(tmp_path, capsys):
-    cv2.imwrite(str(tmp_path / "mask.png"), np.zeros((24, 32), np.uint8))
+    cv2.imwrite(str(tmp_path / "mask.png"), np.full((24, 32), 255, np.uint8))
     args = ["plan", "--rgb", str(FRAME / "color_0.png"), "--depth", str(FRAME / "depth_0.npy"),
             "--intrinsics", str(FRAME / "primesense_overhead_color.intr"), "--mask", str(tmp_path / "mask.png")]
     assert main(args) == 2

@@ -149,6 +149,12 @@ def test_masks(tmp_path):
         np.testing.assert_array_equal(out, mask > 0)
 
 
+def test_an_empty_mask_is_refused_naming_the_file(tmp_path):
+    cv2.imwrite(str(tmp_path / "empty.png"), np.zeros((6, 8), np.uint8))
+    with pytest.raises(InputError, match=r"empty\.png: the mask is empty"):
+        read_mask(tmp_path / "empty.png")
+
+
 # ---------------------------------------------------------------------------
 # Intrinsics
 # ---------------------------------------------------------------------------
@@ -302,7 +308,7 @@ def test_garbage_files_raise_only_input_error(tmp_path, content, suffix):
 def test_a_mask_of_another_size_names_both_files(tmp_path):
     cv2.imwrite(str(tmp_path / "color.png"), np.zeros((240, 320, 3), np.uint8))
     np.save(tmp_path / "depth.npy", np.full((480, 640), 0.7))
-    cv2.imwrite(str(tmp_path / "mask.png"), np.zeros((240, 320), np.uint8))
+    cv2.imwrite(str(tmp_path / "mask.png"), np.full((240, 320), 255, np.uint8))
     intr = write(tmp_path / "camera.json", json.dumps(PLAIN))
     with pytest.raises(InputError, match=r"depth.npy is 640x480 but .*mask.png is 320x240"):
         read_rgbd(None, tmp_path / "depth.npy", intr, mask_path=tmp_path / "mask.png")

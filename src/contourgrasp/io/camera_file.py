@@ -85,14 +85,17 @@ def read_rgb(path) -> np.ndarray:
 
 
 def read_mask(path) -> np.ndarray:
-    """(H, W) bool: a mask image or ``.npy``; non-zero in any channel is object."""
+    """(H, W) bool: a mask image or ``.npy``; non-zero in any channel is object, and some pixel must be."""
     path = Path(path)
     data = _load_npy(path) if path.suffix.lower() == ".npy" else _read_image(path, cv2.IMREAD_UNCHANGED)
     if data.ndim == 3:
         data = np.any(data != 0, axis=2)
     if data.ndim != 2:
         raise InputError(f"{path}: a mask must be a 2-D image, got shape {data.shape}")
-    return np.nan_to_num(data.astype(float)) != 0
+    mask = np.nan_to_num(data.astype(float)) != 0
+    if not mask.any():
+        raise InputError(f"{path}: the mask is empty (no non-zero pixel marks the object)")
+    return mask
 
 
 def read_depth(path, *, depth_scale: float = DEPTH_SCALE) -> np.ndarray:
