@@ -238,6 +238,17 @@ def test_the_small_object_rule_plans_fewer_touching_fingers_and_says_why_when_it
         cg.synthesize(disc / 7, "five-finger-linear", small_objects=True, **grid)
 
 
+def test_a_reason_every_attempt_shares_is_given_once():
+    theta = np.linspace(0, 2 * np.pi, 200, endpoint=False)
+    table_top = 0.5 * np.stack([np.cos(theta), np.sin(theta)], axis=1)  # 1 m across: larger than the hand
+    grid = {"yaw_step": math.radians(30), "xy_step": 0.05}
+    with pytest.raises(cg.NoFeasibleGrasp) as refused:
+        cg.synthesize(table_top, "five-finger-linear", small_objects=True, **grid)
+    message = str(refused.value)
+    assert message.count("larger than the hand") == 1
+    assert message.endswith("(the same with the small-object rule, down to 2 touching fingers)")
+
+
 def test_the_low_object_rule_pinches_with_the_thumb_and_the_fingertips_balls_on_the_grown_outline():
     circle = disc(0.04)  # 8 cm across: the fingers reach it as points
     hand = cg.load_hand("five-finger-linear")

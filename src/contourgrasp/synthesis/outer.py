@@ -329,14 +329,19 @@ NOTE_UNBALANCED = ("no pose balances the squeeze within max_imbalance = {limit:g
 
 
 def _no_grasp(errors: list[NoFeasibleGrasp], counts: int, fewest: int) -> str:
-    """The first attempt's reason, the small-object rule's last, and the search without the squeeze's balance."""
+    """The first attempt's reason, the small-object rule's last, and the search without the squeeze's balance.
+
+    A later attempt that failed for the first one's reason is named, not its reason repeated.
+    """
     errors = [str(error) for error in errors]
-    message = errors[0]
+    later = []
     if counts > 1:
-        message += f"; with the small-object rule, down to {fewest} touching fingers: {errors[counts - 1]}"
+        later.append((f"with the small-object rule, down to {fewest} touching fingers", errors[counts - 1]))
     if len(errors) > counts:
-        message += f"; without the squeeze's balance: {errors[-1]}"
-    return message
+        later.append(("without the squeeze's balance", errors[-1]))
+    same = [attempt for attempt, reason in later if reason == errors[0]]
+    message = errors[0] + (f" (the same {', and '.join(same)})" if same else "")
+    return "; ".join([message] + [f"{attempt}: {reason}" for attempt, reason in later if reason != errors[0]])
 
 
 def _needing(screen: PoseEvaluation, counts: np.ndarray, touching: int) -> PoseEvaluation:
