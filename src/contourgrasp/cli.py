@@ -276,7 +276,7 @@ def _add_bench_parser(sub) -> None:
     bench.add_argument("--approach", choices=APPROACHES, help="with --hand-model: see hand-from-model")
     bench.add_argument("--scene", choices=("single", "clutter", "bin"), default="single",
                        help="one object on the table (default), 2-4 on the table, or 1-3 in a bin: each object "
-                            "in turn the target among the others of its set (see README, 'Clutter and bin scenes')")
+                            "in turn the target among the others of its set (see docs/bench.md, 'Clutter and bin scenes')")
 
 
 def _add_calibrate_parser(sub) -> None:

@@ -430,7 +430,7 @@ IMBALANCE_SCREEN = 0.05
 HAND_MAX_IMBALANCE = 0.25
 
 #: The small-object rule (pipeline.plan_frame(small_objects=True)): the fewest touching fingers it plans with (at
-#: least the hand's required ones): the thumb against one finger. Chosen on ycb-train (README, "3-D hand"): with
+#: least the hand's required ones): the thumb against one finger. Chosen on ycb-train (docs/hand3d.md): with
 #: three, the strawberry still had no plan.
 SMALL_OBJECT_TOUCHING = 2
 

@@ -3,7 +3,7 @@
 A planner is the part of a plan that is not the hand: how the contour is
 modelled, how finely poses are searched, which safeguards apply. ``paper``
 reproduces the thesis; ``default`` is the best the simulated bench has shown
-(README, "Simulated grasping experiment"). Schema (SI units, angles in radians;
+(docs/bench.md, "Simulated grasping experiment"). Schema (SI units, angles in radians;
 every key but ``name`` optional, a missing key takes the function's default,
 which is the thesis's setting)::
 

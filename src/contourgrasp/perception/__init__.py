@@ -28,7 +28,7 @@ One module per stage, in the order the pipeline runs them:
 
 Conventions: see :mod:`~contourgrasp.perception.camera`. The thresholds are in
 :mod:`contourgrasp.tolerances`; measured results (IoU against the hand-made
-masks, timings) in the README's "Perception" section and ``benchmarks/``.
+masks, timings) in docs/perception.md and ``benchmarks/``.
 """
 
 from __future__ import annotations

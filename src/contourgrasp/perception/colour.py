@@ -2,7 +2,7 @@
 
 Colour-depth registration. The shared PrimeSense pairs are sold as registered,
 but an object's outline in depth lies a few pixels above its outline in colour
-(README, "Perception"). So ``"auto"`` segmentation first finds that shift where
+(docs/perception.md). So ``"auto"`` segmentation first finds that shift where
 the object is (:func:`colour_offset`, edge correlation) and moves the colour
 image onto the depth image (:func:`register_colour`) before it looks for flat
 parts (:func:`add_flat_parts`); masks and contours stay in depth pixels (the

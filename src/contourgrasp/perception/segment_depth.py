@@ -56,7 +56,7 @@ def segment_depth(
     top-down camera keeps the thesis's reading, the region seen, which eq
     3.1-3.2 then measure at the table's depth (the outline overstated by
     height / depth); the footprint would measure it exactly, but it lowered
-    the success rates of the simulated top-down bench (README, "Perception"),
+    the success rates of the simulated top-down bench (docs/perception.md),
     so it is an option there (``plan_grasp(footprint=True)``).
 
     An object, or a part of one, lower than ``min_height`` is invisible to this
@@ -271,7 +271,7 @@ def object_footprint(mask, depth, intrinsics: Intrinsics, plane: Plane) -> np.nd
     both: it is where the object stands, the outline a hand approaching along
     the table's normal closes on, and on the shared PrimeSense frames it is
     nearer to the hand-made masks than the region seen above the table
-    (``benchmarks/segmentation.py``, README "Perception").
+    (``benchmarks/segmentation.py``, docs/perception.md).
 
     Parameters
     ----------

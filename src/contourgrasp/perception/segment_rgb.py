@@ -34,7 +34,7 @@ def segment_rgb(
 
     The defaults (11 px blocks, c = 2) find the object on all five shared
     PrimeSense frames, but its outline includes shadows and straps (the
-    figures are in the README, "Perception").
+    figures are in docs/perception.md).
 
     Parameters
     ----------

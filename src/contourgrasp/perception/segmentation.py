@@ -17,7 +17,7 @@ Methods, each returning a :class:`~contourgrasp.perception.region.Segmentation`:
 The ``"auto"`` rule (our reading; the thesis uses RGB only). Depth first: it
 does not see shadows, printed texture or the table's edge, and on the shared
 PrimeSense frames it is far nearer to the hand-made masks than the RGB steps
-(README, "Perception"), except where the object is partly flat; so, with a
+(docs/perception.md), except where the object is partly flat; so, with a
 colour image, the flat parts are added by colour. The RGB steps are used when
 there is no depth image, no table plane (:class:`SegmentationError` of kind
 ``"no-plane"``), or nothing of size stands above the table (kinds

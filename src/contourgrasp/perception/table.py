@@ -200,7 +200,7 @@ def fit_table_plane(
     The camera looks down on a table that fills much of the view (section
     4.1.3), so the dominant plane facing the camera is taken to be the table.
     Its ``tilt`` is the camera's deviation from top-down (the shared
-    PrimeSense frames' are in the README, "Perception").
+    PrimeSense frames' are in docs/perception.md).
 
     Parameters
     ----------

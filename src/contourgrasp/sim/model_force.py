@@ -3,7 +3,7 @@
 The model is closed as :mod:`contourgrasp.sim.model_hand` closes it to derive a hand file (its
 docstring: palm fixed, gravity and contacts off, the synergy ramped from open to closed), and the
 drives' joint forces are read part way through. Not part of the hand file: the planner's squeeze
-balance takes every finger as pushing equally hard (README, "The bench on the models", and
+balance takes every finger as pushing equally hard (docs/hand-models.md, "The bench on the models", and
 ``benchmarks/balance_sweep.md``, for what weighing them did).
 """
 

@@ -29,7 +29,7 @@ so that an opposed thumb shorter than the fingers reaches the object with them, 
 lowest finger (the grasp height counts from the lowest open tip). Our reading for a humanlike
 hand: along the fingers, the Inspire's open fingertips hang 134-147 mm below the palm and its
 thumb's 48 mm, so a descent that brings the fingers to the object leaves the thumb a hand's width
-above it; levelled, they meet it together (README, "The bench on the models", for what it lifts).
+above it; levelled, they meet it together (docs/hand-models.md, "The bench on the models", for what it lifts).
 It needs two fingers at least, the first not straight along the approach from the others. The origin
 is the palm body's origin moved along z to the palm's underside: the largest z of the palm's own
 collision geoms (those of bodies welded to it), but no deeper than the shallowest finger's first
@@ -53,7 +53,7 @@ joint to tip, its open and closed joint angles measured in the chain's plane, wh
 plane) is given its chain as measured, a :class:`~contourgrasp.hand.SampledChain`: its hinges'
 anchors and its tip along the recorded closing (:func:`~contourgrasp.sim.model_fit.sampled_chain`),
 every link a capsule of the finger's radius (a bounding capsule of each link's geoms was tried and
-refused too much: README, "The bench on the models"). The palm
+refused too much: docs/hand-models.md, "The bench on the models"). The palm
 (:func:`~contourgrasp.sim.model_fit.palm_plate`): one collision geom's box gives its tilted
 underside face; several give their rectangle, as deep as their deepest corner. The hand keeps
 its chains and palm only when every finger has a chain; otherwise it is a 2-D hand, and
@@ -166,12 +166,12 @@ _INSPIRE_FINGERS = ("thumb", "index", "middle", "ring", "pinky")
 
 #: The hand models shipped with the package (from robosuite 1.5.2, MIT; data/models/README.md). The
 #: Inspire hand's thumb rotation is its own motor: held opposed (the high end), not part of the synergy; it is read
-#: :data:`LEVEL` (chosen on ycb-train and the thesis's five: README, "The bench on the models"). The Jaco's
+#: :data:`LEVEL` (chosen on ycb-train and the thesis's five: docs/hand-models.md, "The bench on the models"). The Jaco's
 #: fingers each hold their own position: its squeeze's balance is off (max_imbalance 1), chosen on its ycb-train
 #: and thesis's-five trials (benchmarks/balance_sweep.md). The Inspire's fingertips brush the table
-#: (tips_brush_table), the Jaco's do not: chosen on the same trials (README, "The 3-D hand in the plan"). The
+#: (tips_brush_table), the Jaco's do not: chosen on the same trials (docs/hand3d.md, "The 3-D hand in the plan"). The
 #: Inspire's curling fingers are asked for no part of the object's height (grasp_height_fraction 0): chosen on its
-#: ycb-train trials (README, "The bench on the models").
+#: ycb-train trials (docs/hand-models.md, "The bench on the models").
 MODELS = {
     "inspire": _bundled(
         "inspire", "inspire_right_hand.xml", _INSPIRE_FINGERS, palm="r_palm",

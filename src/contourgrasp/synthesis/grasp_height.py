@@ -16,15 +16,15 @@ a pose whose open hand cannot descend that low stops as high as its bodies need,
     A tilted palm (a hand model's, :attr:`~contourgrasp.hand.Palm.plane`) reaches below that plane
     at one end; the rule still counts from the plane, and the descent check keeps the tilted
     underside itself above the object, pose by pose (chosen on the training objects with the Inspire
-    model: README, "The bench on the models").
+    model: docs/hand-models.md, "The bench on the models").
 ``"auto"``
     The same height asked for, at least the hand's :attr:`Hand.grasp_height_fraction` of the
     object's height (``tolerances.GRASP_HEIGHT_FRACTION``, 0.4, unless its file says), raised where
     the bodies need it up to ``tolerances.MAX_GRASP_HEIGHT_FRACTION`` of it: the tips still close on
     its lower part, below its widest part for most objects lying or standing on a table. Chosen on
-    the ``ycb-train`` objects (README, "3-D hand"); the Inspire model's fingers, curling, lift their
+    the ``ycb-train`` objects (docs/hand3d.md); the Inspire model's fingers, curling, lift their
     tips toward the palm as they close, and its fraction is 0 (the tips as low as the rest of this
-    rule lets them), chosen on its training trials (README, "The bench on the models"). A hand whose
+    rule lets them), chosen on its training trials (docs/hand-models.md, "The bench on the models"). A hand whose
     fingertips brush the table (:attr:`Hand.tips_brush_table`) is asked for its open tips just
     above the table, its radius plus ``tolerances.GRASP_TIP_CLEARANCE``, without the swing of a
     leaning finger that dips lower as it closes; it may still be raised to the height where no

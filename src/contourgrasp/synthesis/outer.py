@@ -142,7 +142,7 @@ def search(
         which would otherwise prefer poses where they touch too; only where no such pose is feasible,
         the search as without it. Our reading of why: a one-DoF hand lifts a flat object lying on the table
         between thumb and index, the balls' sides meeting its edges, while the other fingers, arriving on
-        it first or pressing on its top, push it away (README, "The 3-D hand in the plan").
+        it first or pressing on its top, push it away (docs/hand3d.md, "The 3-D hand in the plan").
     descent : Descent, optional
         The scene's height map and the grasp height: a pose is feasible only if the open hand,
         lowered along the approach axis until its lowest fingertip is at ``descent.tip_height``,
