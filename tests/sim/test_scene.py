@@ -155,3 +155,44 @@ def test_a_plan_from_a_tilted_camera_lands_on_the_object(name):
     centre = T_world_hand @ [*hand.grasp_centre, 0.0, 1.0]
     assert np.linalg.norm(centre[:2] - scene.object_com()[:2]) < 0.03
     assert abs(T_world_hand[2, 3] - (scene.object_points()[:, 2].max() - 0.01)) < 0.003
+
+
+def _squeezed_box_drop(margin: float, mass: float = 0.05) -> float:
+    """m: how far a box squeezed between two pads with the scene's solver and grip contact falls in 2 s.
+
+    ``margin`` is the friction cone's limit over the load, mu 2F / (m g): above 1 Coulomb friction holds the
+    box still, below 1 it slides.
+    """
+    import mujoco
+
+    from contourgrasp.sim.objects import ObjectSpec, Part
+    from contourgrasp.sim.scene import SOLVER, grip_contact
+
+    box = ObjectSpec("box", (Part("box", size=(0.015, 0.03, 0.03)),), mass=mass, friction_hand=0.6, friction_table=0.4)
+    squeeze = margin * mass * 9.81 / (2 * box.friction_hand)
+    pads = "".join(f'<body name="{n}" pos="{x} 0 0.3"><joint name="{n}" type="slide" axis="{-np.sign(x)} 0 0"/>'
+                   f'<geom name="{n}" type="sphere" size="0.01" mass="0.1" contype="0" conaffinity="0"/></body>'
+                   for n, x in (("left", -0.03), ("right", 0.03)))
+    model = mujoco.MjModel.from_xml_string(f"""<mujoco>{SOLVER}<worldbody>{pads}
+      <body name="box" pos="0 0 0.3"><freejoint/><geom name="box" type="box" size="0.015 0.03 0.03" mass="{mass}"
+        contype="0" conaffinity="0"/></body></worldbody>
+      <contact>{"".join(f'<pair geom1="box" geom2="{n}" {grip_contact(box)}/>' for n in ("left", "right"))}</contact>
+      <actuator><motor joint="left"/><motor joint="right"/></actuator></mujoco>""")
+    data = mujoco.MjData(model)
+    data.ctrl[:] = squeeze
+    model.opt.gravity[:] = 0
+    mujoco.mj_step(model, data, nstep=250)  # squeezed, then let go into gravity
+    start = data.body("box").xpos[2]
+    model.opt.gravity[:] = (0, 0, -9.81)
+    mujoco.mj_step(model, data, nstep=round(2.0 / model.opt.timestep))
+    return start - data.body("box").xpos[2]
+
+
+@pytest.mark.parametrize("margin", [1.2, 2.0, 20.0])
+def test_a_hold_inside_the_friction_cone_does_not_creep(margin):
+    assert abs(_squeezed_box_drop(margin)) < 2e-4  # 0.4-0.75 mm at impratio 10
+
+
+@pytest.mark.parametrize("margin", [0.5, 0.9])
+def test_a_load_outside_the_friction_cone_slides(margin):
+    assert _squeezed_box_drop(margin) > 1.0

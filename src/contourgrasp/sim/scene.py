@@ -24,8 +24,19 @@ table, see :mod:`contourgrasp.sim.objects`; object on object, the mean of their
 table frictions; the bin's floor as the table, its walls without rolling
 friction); hand geoms collide with the table and the bin by their contact bits
 and never with each other. Solver settings follow what
-makes grasps hold in MuJoCo: elliptic friction cones, ``impratio`` 10, the
-``implicitfast`` integrator, a 2 ms step.
+makes grasps hold in MuJoCo: elliptic friction cones, ``impratio``
+:data:`IMPRATIO`, the ``implicitfast`` integrator, a 2 ms step.
+
+MuJoCo's friction is a soft constraint: a contact well inside its friction
+cone still creeps, at a rate that falls as ``impratio`` (the friction's
+impedance over the normal's) rises. Coulomb friction does not creep, and
+neither does a real grasp held inside its cones; a creeping hold lets a
+squeezed light object work its way out of the hand (the 6.2 g YCB sponge,
+squeezed by four fingers, rose 2-11 cm out of the hand during the hold at
+``impratio`` 10). Measured on two pads squeezing a box against gravity
+(``tests/sim/test_scene.py``), a hold inside the cone creeps 0.4-0.75 mm in
+2 s at 10 and 0.04-0.08 mm at 100, while a load outside the cone slides
+as before; hence 100, as MuJoCo Menagerie's quadrupeds use for their feet.
 """
 
 from __future__ import annotations
@@ -52,6 +63,11 @@ TIMESTEP = 0.002
 SETTLE_TIME = 0.4
 #: Height of the parked hand, far above the camera (m).
 PARK_HEIGHT = 2.0
+#: Ratio of the friction constraints' impedance to the normal's (elliptic cones): how little a hold creeps
+#: (module docstring; 10 until 2026-12-04).
+IMPRATIO = 100
+#: The scene's solver settings (module docstring).
+SOLVER = f'<option timestep="{TIMESTEP}" integrator="implicitfast" cone="elliptic" impratio="{IMPRATIO}"/>'
 #: Rolling friction of objects on the table, m (torque per unit normal force).
 ROLLING = 0.0005
 #: Rotation from the camera optical frame to the world frame.
@@ -367,7 +383,7 @@ def scene_xml(obj: ObjectSpec, hand: HandModel, placement: Placement, *, neighbo
     pairs = _pairs([("object", obj), *((f"neighbour_{k}", o) for k, (o, _) in enumerate(neighbours))], hand, bin)
     return f"""<mujoco model="contourgrasp-sim">
   <compiler angle="radian" autolimits="true"/>
-  <option timestep="{TIMESTEP}" integrator="implicitfast" cone="elliptic" impratio="10"/>
+  {SOLVER}
   <asset>
     {chr(10).join(assets)}
   </asset>
@@ -418,8 +434,7 @@ def _pairs(bodies, hand: HandModel, bin: Bin | None = None) -> list[str]:
     pairs = []
     parts = {name: [f"{name}_{i}" for i in range(len(obj.collision))] for name, obj in bodies}
     for name, obj in bodies:
-        # condim 4 with a little torsional friction: fingertip pads resist spinning the object.
-        grip = f'condim="4" friction="{obj.friction_hand} {obj.friction_hand} 0.005 0.0001 0.0001" solref="0.01 1"'
+        grip = grip_contact(obj)
         for geom in parts[name]:
             pairs.append(f'<pair geom1="{geom}" geom2="table" {_resting(obj)}/>')
             pairs += [f'<pair geom1="{geom}" geom2="{g}" {grip}/>' for g in hand.geom_names()]
@@ -434,6 +449,12 @@ def _pairs(bodies, hand: HandModel, bin: Bin | None = None) -> list[str]:
                 f'condim="3" friction="{obj.friction_table} {obj.friction_table}" solref="0.01 1"'
             pairs += [f'<pair geom1="{geom}" geom2="{box}" {how}/>' for geom in parts[name]]
     return pairs
+
+
+def grip_contact(obj: ObjectSpec) -> str:
+    """The contact attributes of ``obj`` against the hand's geoms (a ``<pair>``'s, without the geoms)."""
+    # condim 4 with a little torsional friction: fingertip pads resist spinning the object.
+    return f'condim="4" friction="{obj.friction_hand} {obj.friction_hand} 0.005 0.0001 0.0001" solref="0.01 1"'
 
 
 def _resting(obj: ObjectSpec) -> str:
