@@ -32,8 +32,8 @@ cone still creeps, at a rate that falls as ``impratio`` (the friction's
 impedance over the normal's) rises. Coulomb friction does not creep, and
 neither does a real grasp held inside its cones; a creeping hold lets a
 squeezed light object work its way out of the hand (the 6.2 g YCB sponge,
-squeezed by four fingers, rose 2-11 cm out of the hand during the hold at
-``impratio`` 10). Measured on two pads squeezing a box against gravity
+squeezed by four fingers, slid 2-11 cm in the hand during the hold at
+``impratio`` 10, mostly upward out of it). Measured on two pads squeezing a box against gravity
 (``tests/sim/test_scene.py``), a hold inside the cone creeps 0.4-0.75 mm in
 2 s at 10 and 0.04-0.08 mm at 100, while a load outside the cone slides
 as before; hence 100, as MuJoCo Menagerie's quadrupeds use for their feet.
