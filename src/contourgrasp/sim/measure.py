@@ -1,4 +1,6 @@
-"""How well the simulated hand follows its 2-D preset: fingertip paths closing in free space.
+"""Measurements of the simulation as an instrument: fingertip paths, and how much a hold creeps.
+
+How well the simulated hand follows its 2-D preset: fingertip paths closing in free space.
 
 The synthesis assumes each fingertip's projection onto the image plane moves on
 the segment ``start -> start + travel * closing_direction`` (eq 3.18). The
@@ -7,6 +9,9 @@ simulated fingers are planar chains built to do so (see
 is dynamics: the soft joint limits the tip overshoots at the end, the base
 servo giving way to the fingers' reaction, joint compliance. These functions
 measure it.
+
+How much a hold inside its friction cones creeps (:func:`squeeze_creep`): the
+reason for :data:`~contourgrasp.sim.scene.IMPRATIO` (see :mod:`contourgrasp.sim.scene`).
 """
 
 from __future__ import annotations
@@ -16,7 +21,8 @@ import numpy as np
 from ..errors import SimulationError
 from ..hand import polyline_distance
 from .hand_model import HandDesign
-from .scene import build_scene
+from .objects import ObjectSpec, Part
+from .scene import IMPRATIO, SOLVER, build_scene, grip_contact
 
 #: Palm height for free-space closing: fingertips far above the table and the object.
 FREE_SPACE_HEIGHT = 0.6
@@ -66,3 +72,41 @@ def fingertip_path_error(hand="five-finger-linear", **kwargs) -> dict[str, float
     preset = load_hand(hand)
     paths = fingertip_paths(preset, **kwargs)
     return {f.name: 1000.0 * float(polyline_distance(paths[f.name], [f.start, f.end]).max()) for f in preset.fingers}
+
+
+def squeeze_creep(margin: float, *, impratio: float = IMPRATIO, noslip: int = 0, mass: float = 0.05,
+                  hold_time: float = 2.0) -> float:
+    """m: how far a box squeezed between two pads falls while gravity pulls it for ``hold_time`` s.
+
+    The scene's solver settings (:data:`~contourgrasp.sim.scene.SOLVER`, with ``impratio`` and MuJoCo's
+    ``noslip_iterations`` as given) and its grip contact (:func:`~contourgrasp.sim.scene.grip_contact`);
+    the pads are position-free sliders pushed together, the box of ``mass`` kg starts at rest between
+    them. ``margin`` is the friction cone's limit over the load, mu 2F / (m g): above 1 Coulomb friction
+    holds the box still, below 1 it slides.
+
+    Examples
+    --------
+    >>> squeeze_creep(2.0) < 2e-4 < 1.0 < squeeze_creep(0.5)
+    True
+    """
+    import mujoco
+
+    box = ObjectSpec("box", (Part("box", size=(0.015, 0.03, 0.03)),), mass=mass, friction_hand=0.6,
+                     friction_table=0.4)
+    option = SOLVER.replace(f'impratio="{IMPRATIO}"', f'impratio="{impratio:g}" noslip_iterations="{noslip}"')
+    pads = "".join(f'<body name="{n}" pos="{x} 0 0.3"><joint name="{n}" type="slide" axis="{-np.sign(x)} 0 0"/>'
+                   f'<geom name="{n}" type="sphere" size="0.01" mass="0.1" contype="0" conaffinity="0"/></body>'
+                   for n, x in (("left", -0.03), ("right", 0.03)))
+    model = mujoco.MjModel.from_xml_string(f"""<mujoco>{option}<worldbody>{pads}
+      <body name="box" pos="0 0 0.3"><freejoint/><geom name="box" type="box" size="0.015 0.03 0.03" mass="{mass}"
+        contype="0" conaffinity="0"/></body></worldbody>
+      <contact>{"".join(f'<pair geom1="box" geom2="{n}" {grip_contact(box)}/>' for n in ("left", "right"))}</contact>
+      <actuator><motor joint="left"/><motor joint="right"/></actuator></mujoco>""")
+    data = mujoco.MjData(model)
+    data.ctrl[:] = margin * mass * 9.81 / (2 * box.friction_hand)
+    model.opt.gravity[:] = 0
+    mujoco.mj_step(model, data, nstep=250)  # squeezed at rest, then let go into gravity
+    start = data.body("box").xpos[2]
+    model.opt.gravity[:] = (0, 0, -9.81)
+    mujoco.mj_step(model, data, nstep=round(hold_time / model.opt.timestep))
+    return float(start - data.body("box").xpos[2])

@@ -34,7 +34,7 @@ neither does a real grasp held inside its cones; a creeping hold lets a
 squeezed light object work its way out of the hand (the 6.2 g YCB sponge,
 squeezed by four fingers, slid 2-11 cm in the hand during the hold at
 ``impratio`` 10, mostly upward out of it). Measured on two pads squeezing a box against gravity
-(``tests/sim/test_scene.py``), a hold inside the cone creeps 0.4-0.75 mm in
+(:func:`~contourgrasp.sim.measure.squeeze_creep`), a hold inside the cone creeps 0.4-0.75 mm in
 2 s at 10 and 0.04-0.08 mm at 100, while a load outside the cone slides
 as before; hence 100, as MuJoCo Menagerie's quadrupeds use for their feet.
 """
