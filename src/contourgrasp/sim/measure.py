@@ -16,13 +16,18 @@ reason for :data:`~contourgrasp.sim.scene.IMPRATIO` (see :mod:`contourgrasp.sim.
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
-from ..errors import SimulationError
-from ..hand import polyline_distance
-from .hand_model import HandDesign
-from .objects import ObjectSpec, Part
-from .scene import IMPRATIO, SOLVER, build_scene, grip_contact
+os.environ.setdefault("MUJOCO_GL", "disable")
+import mujoco  # noqa: E402
+
+from ..errors import SimulationError  # noqa: E402
+from ..hand import polyline_distance  # noqa: E402
+from .hand_model import HandDesign  # noqa: E402
+from .objects import ObjectSpec, Part  # noqa: E402
+from .scene import IMPRATIO, SOLVER, build_scene, grip_contact  # noqa: E402
 
 #: Palm height for free-space closing: fingertips far above the table and the object.
 FREE_SPACE_HEIGHT = 0.6
@@ -80,8 +85,8 @@ def squeeze_creep(margin: float, *, impratio: float = IMPRATIO, noslip: int = 0,
 
     The scene's solver settings (:data:`~contourgrasp.sim.scene.SOLVER`, with ``impratio`` and MuJoCo's
     ``noslip_iterations`` as given) and its grip contact (:func:`~contourgrasp.sim.scene.grip_contact`);
-    the pads are position-free sliders pushed together, the box of ``mass`` kg starts at rest between
-    them. ``margin`` is the friction cone's limit over the load, mu 2F / (m g): above 1 Coulomb friction
+    the pads slide on rails and are pushed together with a constant force; the box of ``mass`` kg is
+    squeezed at rest between them without gravity for 0.5 s before gravity is turned on. ``margin`` is the friction cone's limit over the load, mu 2F / (m g): above 1 Coulomb friction
     holds the box still, below 1 it slides.
 
     Examples
@@ -89,8 +94,6 @@ def squeeze_creep(margin: float, *, impratio: float = IMPRATIO, noslip: int = 0,
     >>> squeeze_creep(2.0) < 2e-4 < 1.0 < squeeze_creep(0.5)
     True
     """
-    import mujoco
-
     box = ObjectSpec("box", (Part("box", size=(0.015, 0.03, 0.03)),), mass=mass, friction_hand=0.6,
                      friction_table=0.4)
     option = SOLVER.replace(f'impratio="{IMPRATIO}"', f'impratio="{impratio:g}" noslip_iterations="{noslip}"')

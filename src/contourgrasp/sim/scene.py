@@ -30,13 +30,11 @@ makes grasps hold in MuJoCo: elliptic friction cones, ``impratio``
 MuJoCo's friction is a soft constraint: a contact well inside its friction
 cone still creeps, at a rate that falls as ``impratio`` (the friction's
 impedance over the normal's) rises. Coulomb friction does not creep, and
-neither does a real grasp held inside its cones; a creeping hold lets a
-squeezed light object work its way out of the hand (the 6.2 g YCB sponge,
-squeezed by four fingers, slid 2-11 cm in the hand during the hold at
-``impratio`` 10, mostly upward out of it). Measured on two pads squeezing a box against gravity
-(:func:`~contourgrasp.sim.measure.squeeze_creep`), a hold inside the cone creeps 0.4-0.75 mm in
-2 s at 10 and 0.04-0.08 mm at 100, while a load outside the cone slides
-as before; hence 100, as MuJoCo Menagerie's quadrupeds use for their feet.
+neither does a real grasp held inside its cones, while a creeping hold lets
+a squeezed light object work its way out of the hand. ``impratio`` is chosen
+on a squeeze without any planner (:func:`~contourgrasp.sim.measure.squeeze_creep`:
+a hold inside the cone must not creep, a load outside it must slide); the
+figures, and the bench before and after: ``docs/bench.md``, "The friction's creep".
 """
 
 from __future__ import annotations
