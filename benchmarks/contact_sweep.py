@@ -4,13 +4,13 @@ Two measurements, neither of which changes the library:
 
 ``--squeeze``
     No planner: ``sim.measure.squeeze_creep`` (two pads squeeze a box against gravity with the scene's
-    grip contact and solver settings) with ``impratio`` (and, with ``--noslip``, MuJoCo's noslip
+    grip contact and solver settings, ``sim.scene.solver_option``) with ``impratio`` (and, with ``--noslip``, MuJoCo's noslip
     iterations) as given; prints how far the box falls in 2 s at several friction margins (the cone's
     limit over the load: above 1 Coulomb friction holds it still, below 1 it slides).
 ``--objects SPLIT``
     The bench's single-scene trials of ``default`` (seed = trial, as ``contourgrasp bench`` runs them) with
-    the hand-object contacts' ``solref`` time constant, ``solimp``, torsional friction or the scene's
-    ``<option>`` attributes replaced; prints successes and failures by cause.
+    the hand-object contact's ``solref`` time constant, ``solimp`` or torsional friction
+    (``sim.scene.grip_contact``), ``impratio`` or the noslip iterations (``sim.scene.solver_option``) replaced; prints successes and failures by cause.
 
 Usage::
 
@@ -37,25 +37,18 @@ MARGINS = (0.5, 0.9, 1.2, 2.0, 5.0, 20.0)
 
 
 def patch_contacts(args) -> None:
-    """Replace the scene's contact settings in this process (and in the workers it forks)."""
-    pairs, scene_xml = scene_module._pairs, scene_module.scene_xml
+    """Replace the scene's solver settings and grip contact in this process (and in the workers it forks)."""
+    grip = scene_module.grip_contact
 
-    def patched_pairs(*a, **k):
-        out = []
-        for pair in pairs(*a, **k):
-            if 'condim="4"' in pair:  # the hand-object pairs (grip_contact)
-                pair = pair.replace('solref="0.01 1"', f'solref="{args.timeconst:g} 1"'
-                                    + (f' solimp="{args.solimp}"' if args.solimp else ""))
-                if args.torsion is not None:
-                    pair = pair.replace(' 0.005 0.0001 0.0001"', f' {args.torsion:g} 0.0001 0.0001"')
-            out.append(pair)
-        return out
+    def patched_grip(obj):
+        attributes = grip(obj).replace('solref="0.01 1"', f'solref="{args.timeconst:g} 1"'
+                                       + (f' solimp="{args.solimp}"' if args.solimp else ""))
+        if args.torsion is not None:
+            attributes = attributes.replace(' 0.005 0.0001 0.0001"', f' {args.torsion:g} 0.0001 0.0001"')
+        return attributes
 
-    def patched_xml(*a, **k):
-        xml = scene_xml(*a, **k).replace(f'impratio="{scene_module.IMPRATIO}"', f'impratio="{args.impratio[0]:g}"')
-        return xml.replace('cone="elliptic"', f'cone="elliptic" noslip_iterations="{args.noslip}"', 1)
-
-    scene_module._pairs, scene_module.scene_xml = patched_pairs, patched_xml
+    scene_module.grip_contact = patched_grip
+    scene_module.SOLVER = scene_module.solver_option(args.impratio[0], args.noslip)
 
 
 def _trial(task):

@@ -27,7 +27,7 @@ from ..errors import SimulationError  # noqa: E402
 from ..hand import polyline_distance  # noqa: E402
 from .hand_model import HandDesign  # noqa: E402
 from .objects import ObjectSpec, Part  # noqa: E402
-from .scene import IMPRATIO, SOLVER, build_scene, grip_contact  # noqa: E402
+from .scene import IMPRATIO, build_scene, grip_contact, solver_option  # noqa: E402
 
 #: Palm height for free-space closing: fingertips far above the table and the object.
 FREE_SPACE_HEIGHT = 0.6
@@ -83,7 +83,7 @@ def squeeze_creep(margin: float, *, impratio: float = IMPRATIO, noslip: int = 0,
                   hold_time: float = 2.0) -> float:
     """m: how far a box squeezed between two pads falls while gravity pulls it for ``hold_time`` s.
 
-    The scene's solver settings (:data:`~contourgrasp.sim.scene.SOLVER`, with ``impratio`` and MuJoCo's
+    The scene's solver settings (:func:`~contourgrasp.sim.scene.solver_option`, with ``impratio`` and MuJoCo's
     ``noslip_iterations`` as given) and its grip contact (:func:`~contourgrasp.sim.scene.grip_contact`);
     the pads slide on rails and are pushed together with a constant force; the box of ``mass`` kg is
     squeezed at rest between them without gravity for 0.5 s before gravity is turned on. ``margin`` is the friction cone's limit over the load, mu 2F / (m g): above 1 Coulomb friction
@@ -96,11 +96,10 @@ def squeeze_creep(margin: float, *, impratio: float = IMPRATIO, noslip: int = 0,
     """
     box = ObjectSpec("box", (Part("box", size=(0.015, 0.03, 0.03)),), mass=mass, friction_hand=0.6,
                      friction_table=0.4)
-    option = SOLVER.replace(f'impratio="{IMPRATIO}"', f'impratio="{impratio:g}" noslip_iterations="{noslip}"')
     pads = "".join(f'<body name="{n}" pos="{x} 0 0.3"><joint name="{n}" type="slide" axis="{-np.sign(x)} 0 0"/>'
                    f'<geom name="{n}" type="sphere" size="0.01" mass="0.1" contype="0" conaffinity="0"/></body>'
                    for n, x in (("left", -0.03), ("right", 0.03)))
-    model = mujoco.MjModel.from_xml_string(f"""<mujoco>{option}<worldbody>{pads}
+    model = mujoco.MjModel.from_xml_string(f"""<mujoco>{solver_option(impratio, noslip)}<worldbody>{pads}
       <body name="box" pos="0 0 0.3"><freejoint/><geom name="box" type="box" size="0.015 0.03 0.03" mass="{mass}"
         contype="0" conaffinity="0"/></body></worldbody>
       <contact>{"".join(f'<pair geom1="box" geom2="{n}" {grip_contact(box)}/>' for n in ("left", "right"))}</contact>

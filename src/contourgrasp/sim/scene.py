@@ -62,10 +62,18 @@ SETTLE_TIME = 0.4
 #: Height of the parked hand, far above the camera (m).
 PARK_HEIGHT = 2.0
 #: Ratio of the friction constraints' impedance to the normal's (elliptic cones): how little a hold creeps
-#: (module docstring; 10 until 2026-12-04).
+#: (module docstring).
 IMPRATIO = 100
-#: The scene's solver settings (module docstring).
-SOLVER = f'<option timestep="{TIMESTEP}" integrator="implicitfast" cone="elliptic" impratio="{IMPRATIO}"/>'
+
+
+def solver_option(impratio: float = IMPRATIO, noslip: int = 0) -> str:
+    """The scene's ``<option>`` element (module docstring); ``noslip`` MuJoCo's noslip iterations (0: off)."""
+    return (f'<option timestep="{TIMESTEP}" integrator="implicitfast" cone="elliptic" impratio="{impratio:g}" '
+            f'noslip_iterations="{noslip}"/>')
+
+
+#: The scene's solver settings.
+SOLVER = solver_option()
 #: Rolling friction of objects on the table, m (torque per unit normal force).
 ROLLING = 0.0005
 #: Rotation from the camera optical frame to the world frame.
