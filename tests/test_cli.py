@@ -317,10 +317,11 @@ def test_hand_from_model_writes_a_hand_that_plans(tmp_path, capsys, model):
     brushing = "tips_brush_table = true" in hand.read_text()
     assert brushing == (model == "inspire")  # the bundled models' own, chosen on the bench
     assert ("grasp_height_fraction = 0.0" in hand.read_text()) == (model == "inspire")
+    assert ("slice_contour = false" in hand.read_text()) == (model == "inspire")
     code, _, err = run(capsys, "hand-from-model", model, "--out", hand, "--no-tips-brush-table",
-                       "--grasp-height-fraction", "0.3")
+                       "--grasp-height-fraction", "0.3", "--slice-contour", "true")
     assert code == 0 and "tips_brush_table = false" in hand.read_text(), err
-    assert "grasp_height_fraction = 0.3" in hand.read_text()
+    assert "grasp_height_fraction = 0.3" in hand.read_text() and "slice_contour = true" in hand.read_text()
 
 
 def test_hand_from_model_bad_input_is_one_line_and_writes_nothing(tmp_path, capsys):
@@ -337,6 +338,8 @@ def test_hand_from_model_bad_input_is_one_line_and_writes_nothing(tmp_path, caps
         ([tmp_path / "missing.xml", "--fingertips", "tip"], "no such model file"),
         ([model, "--fingertips", "left_tip", "right_tip", "--grasp-height-fraction", "0.9"],
          "grasp_height_fraction must be at most 0.7"),
+        ([model, "--fingertips", "left_tip", "right_tip", "--slice-contour", "sometimes"],
+         "argument --slice-contour: invalid choice: 'sometimes'"),
     ]
     for argv, message in cases:
         code, _, err = run(capsys, "hand-from-model", *argv, "--out", out)

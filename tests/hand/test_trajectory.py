@@ -148,6 +148,8 @@ def test_a_hand_without_fingers_is_a_hand_error():
     (lambda: Hand("h", [Finger("f", (0.0, 0.0), Ray((1.0, 0.0)), 0.1)], 1, tips_brush_table="yes"), "tips_brush_table"),
     (lambda: Hand("h", [Finger("f", (0.0, 0.0), Ray((1.0, 0.0)), 0.1)], 1, grasp_height_fraction=0.8),
      "grasp_height_fraction"),
+    (lambda: Hand("h", [Finger("f", (0.0, 0.0), Ray((1.0, 0.0)), 0.1)], 1, slice_contour="hand"), "slice_contour"),
+    (lambda: Hand("h", [Finger("f", (0.0, 0.0), Ray((1.0, 0.0)), 0.1)], 1, slice_contour=1), "slice_contour"),
     (lambda: Hand("h", [Finger(f"f{i}", (0.0, 0.0), Ray((1.0, 0.0)), 0.1) for i in range(11)], 1), "fingers"),
 ])
 def test_absurd_hand_values_are_hand_errors_naming_the_field(make, field):

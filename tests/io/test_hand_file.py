@@ -59,6 +59,8 @@ def test_a_hand_file_plans_grasps(tmp_path):
          r"tips_brush_table: Input should be a valid boolean"),
         (("min_touching = 2", "min_touching = 2\ngrasp_height_fraction = 0.9", 1),
          r"grasp_height_fraction: Input should be less than or equal to 0.7"),
+        (("min_touching = 2", 'min_touching = 2\nslice_contour = "hand"', 1),
+         r"slice_contour: must be true, false or \"unbalanced\", got 'hand'"),
     ],
 )
 def test_hand_file_errors_name_the_file_and_the_field(tmp_path, edit, message):
@@ -96,11 +98,15 @@ def test_hand_to_toml_round_trips(name):
     hand = load_hand(name)
     again = parse_hand(hand_to_toml(hand, comment="a\nb"))
     assert (again.name, again.min_touching, again.miss_penalty, again.max_imbalance, again.tips_brush_table,
-            again.grasp_height_fraction) == (hand.name, hand.min_touching, hand.miss_penalty, hand.max_imbalance,
-                                             hand.tips_brush_table, hand.grasp_height_fraction)
-    assert "grasp_height_fraction" not in hand_to_toml(hand)  # the default: the presets' files as they were
+            again.grasp_height_fraction, again.slice_contour) == (
+        hand.name, hand.min_touching, hand.miss_penalty, hand.max_imbalance, hand.tips_brush_table,
+        hand.grasp_height_fraction, hand.slice_contour)
+    text = hand_to_toml(hand)
+    assert "grasp_height_fraction" not in text and "slice_contour" not in text  # the defaults: the files as they were
     lower = parse_hand(hand_to_toml(dataclasses.replace(hand, grasp_height_fraction=0.0)))
     assert lower.grasp_height_fraction == 0.0
+    for slicing in (False, True):
+        assert parse_hand(hand_to_toml(dataclasses.replace(hand, slice_contour=slicing))).slice_contour is slicing
     for f, g in zip(hand.fingers, again.fingers, strict=True):
         assert (g.name, g.start, g.travel, g.virtual_start, g.alpha, g.beta, g.required) == (
             f.name, f.start, f.travel, f.virtual_start, f.alpha, f.beta, f.required)

@@ -48,8 +48,8 @@ def test_a_file_round_trips_its_options(tmp_path):
     ('name = "x"\ndescent = 1', "descent"),
     ('name = "x"\ngrasp_height = "high"', "grasp_height"),
     ('name = "x"\ngrasp_height = -0.1', "grasp_height: a grasp height must be in"),
-    ('name = "x"\nslice_contour = "sometimes"', 'slice_contour: must be true, false or "unbalanced", got \'sometimes\''),
-    ('name = "x"\nslice_contour = 1', 'slice_contour: must be true, false or "unbalanced", got 1'),
+    ('name = "x"\nslice_contour = "sometimes"', 'slice_contour: must be true, false, "unbalanced" or "hand", got \'sometimes\''),
+    ('name = "x"\nslice_contour = 1', 'slice_contour: must be true, false, "unbalanced" or "hand", got 1'),
     ('name = "x"\nsmall_objects = "yes"', "small_objects"),
     ('name = "x"\nlow_objects = 1', "low_objects"),
     ('name = "x"\nmax_imbalance = "hands"', "max_imbalance"),
@@ -145,9 +145,10 @@ def test_fuzz_load_planner_on_random_bytes_gives_a_planner_or_a_planner_file_err
     assert planner.name == "x"
 
 
-def test_the_slice_contour_is_a_flag_or_unbalanced():
+def test_the_slice_contour_is_a_flag_unbalanced_or_the_hands():
     planner = parse_planner('name = "x"\nslice_contour = "unbalanced"', source="mine.toml")
     assert planner.plan_options["slice_contour"] == "unbalanced"
+    assert parse_planner('name = "x"\nslice_contour = "hand"').plan_options["slice_contour"] == "hand"
     with pytest.raises(PlannerFileError, match="mine.toml.*slice_contour"):
         parse_planner('name = "x"\nslice_contour = "sometimes"', source="mine.toml")
 

@@ -159,11 +159,15 @@ def test_a_derived_hand_carries_the_models_squeeze_balance_and_table_brushing(sl
     assert (jaco.max_imbalance, jaco.tips_brush_table) == (1.0, False)
     assert (inspire.max_imbalance, inspire.tips_brush_table) == (tol.HAND_MAX_IMBALANCE, True)
     assert (inspire.grasp_height_fraction, jaco.grasp_height_fraction) == (0.0, tol.GRASP_HEIGHT_FRACTION)
+    assert (inspire.slice_contour, jaco.slice_contour) == (False, "unbalanced")
     assert not derive_hand(sliders, fingertips=["left_tip", "right_tip"]).hand.tips_brush_table
-    mine = derive_hand(sliders, fingertips=["left_tip", "right_tip"], max_imbalance=0.5, tips_brush_table=True).hand
-    assert (mine.max_imbalance, mine.tips_brush_table) == (0.5, True)
+    mine = derive_hand(sliders, fingertips=["left_tip", "right_tip"], max_imbalance=0.5, tips_brush_table=True,
+                       slice_contour=True).hand
+    assert (mine.max_imbalance, mine.tips_brush_table, mine.slice_contour) == (0.5, True, True)
     with pytest.raises(HandError, match="max_imbalance must be at most 1"):
         derive_hand(sliders, fingertips=["left_tip", "right_tip"], max_imbalance=2.0)
+    with pytest.raises(HandError, match="slice_contour must be one of"):
+        derive_hand(sliders, fingertips=["left_tip", "right_tip"], slice_contour="sometimes")
 
 
 def test_bad_models_are_refused_naming_what(sliders, tmp_path):

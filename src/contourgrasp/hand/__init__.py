@@ -40,10 +40,14 @@ from .trajectory import (
     trajectory_polyline,
 )
 
-__all__ = ["Arc", "Finger", "FingerChain", "Hand", "HandSegments", "Palm", "Ray", "SampledChain", "chain_angles",
-           "chain_capsules", "chain_deviation", "chain_joints", "chain_plane", "chain_tip", "check_chain",
-           "interpolate_samples", "link_names",
+__all__ = ["SLICE_CONTOUR", "Arc", "Finger", "FingerChain", "Hand", "HandSegments", "Palm", "Ray", "SampledChain",
+           "chain_angles", "chain_capsules", "chain_deviation", "chain_joints", "chain_plane", "chain_tip",
+           "check_chain", "interpolate_samples", "link_names",
            "polyline_distance", "rotation", "to_image", "trajectory_polyline"]
+
+
+#: The outlines a 3-D hand may be planned on (:attr:`Hand.slice_contour`; ``plan_frame``'s ``slice_contour``).
+SLICE_CONTOUR = (False, True, "unbalanced")
 
 
 @dataclass(frozen=True)
@@ -80,6 +84,15 @@ class Hand:
         50-65 mm), and from lower down it wraps more of the object's underside. Which height holds
         best depends on how its fingers curl around objects, which no trajectory shows: chosen on the
         bench, as ``max_imbalance`` is.
+    slice_contour : bool or "unbalanced"
+        For a 3-D hand, the outline the planner plans on when it asks for the hand's own
+        (``slice_contour="hand"``, as ``default`` does; :func:`~contourgrasp.pipeline.plan_frame`):
+        ``"unbalanced"`` (the default), the object's cross-section at the grasp height where the outline
+        seen has no balanced squeeze; False, the outline seen always; True, the cross-section always.
+        A hand whose fingertips meet the object near the height they start at closes on the
+        cross-section there; one that wraps the object with its curling links over a range of heights
+        meets it where it is widest, the outline seen. Which holds better depends on how its fingers
+        curl round objects, which no trajectory shows: chosen on the bench, as ``max_imbalance`` is.
     chains : tuple of FingerChain or SampledChain, optional
         The fingers' bodies, one per finger in the order of ``fingers``; None (the default) for a
         2-D hand. Given together with ``palm``.
@@ -90,7 +103,8 @@ class Hand:
     HandError
         No fingers or more than ``tolerances.MAX_FINGERS``, a finger that is not a :class:`Finger`, names not unique, ``min_touching``
         not in 1..number of fingers, ``miss_penalty`` not in [0, ``tolerances.MAX_GAIN``], ``max_imbalance``
-        not in [0, 1], ``tips_brush_table`` not a bool or ``grasp_height_fraction`` out of range;
+        not in [0, 1], ``tips_brush_table`` not a bool, ``grasp_height_fraction`` out of range or
+        ``slice_contour`` not one of :data:`SLICE_CONTOUR`;
         chains without a palm or the reverse, not one chain per finger, or a chain that does not
         realise its finger's trajectory (:func:`check_chain`, naming the finger).
     """
@@ -102,6 +116,7 @@ class Hand:
     max_imbalance: float = tol.HAND_MAX_IMBALANCE
     tips_brush_table: bool = False
     grasp_height_fraction: float = tol.GRASP_HEIGHT_FRACTION
+    slice_contour: bool | str = "unbalanced"
     description: str = field(default="", compare=False)
     chains: tuple[FingerChain | SampledChain, ...] | None = None
     palm: Palm | None = None
@@ -129,6 +144,9 @@ class Hand:
         fraction = check.bounded(f"hand {self.name!r}: grasp_height_fraction", self.grasp_height_fraction,
                                  tol.MAX_GRASP_HEIGHT_FRACTION, "", error=HandError)
         object.__setattr__(self, "grasp_height_fraction", fraction)
+        slicing = bool(self.slice_contour) if isinstance(self.slice_contour, np.bool_) else self.slice_contour
+        object.__setattr__(self, "slice_contour", check.choice(f"hand {self.name!r}: slice_contour", slicing,
+                                                               SLICE_CONTOUR, error=HandError))
         if len({f.name for f in self.fingers}) != n:
             raise HandError(f"hand {self.name!r}: finger names must be unique")
         self._check_body()

@@ -17,6 +17,11 @@ Schema (all lengths in meters, angles in radians)::
                                      # default false: no closing fingertip reaches it
     grasp_height_fraction = 0.4      # optional, 3-D hands, 0..0.7: the least grasp height ("auto")
                                      # as a fraction of the object's height; default 0.4
+    slice_contour = "unbalanced"     # optional, 3-D hands: the outline planned on by a planner
+                                     # asking for the hand's (default's slice_contour = "hand"):
+                                     # "unbalanced" (default) the cross-section at the grasp height
+                                     # where the outline seen has no balanced squeeze; false the
+                                     # outline seen; true the cross-section
 
     [[fingers]]                      # one table per finger, at least one
     name = "thumb"
@@ -64,9 +69,9 @@ and the field; so is a file that is not UTF-8 text or TOML.
 from __future__ import annotations
 
 import json
-from typing import Annotated
+from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from .. import tolerances as tol
 from ..errors import HandError, HandFileError
@@ -173,8 +178,17 @@ class _HandSchema(_Strict):
     tips_brush_table: bool = False
     grasp_height_fraction: Annotated[float, Field(ge=0, le=tol.MAX_GRASP_HEIGHT_FRACTION,
                                                   allow_inf_nan=False)] = tol.GRASP_HEIGHT_FRACTION
+    slice_contour: bool | Literal["unbalanced"] = "unbalanced"
     fingers: list[_FingerSchema] = Field(min_length=1, max_length=tol.MAX_FINGERS)
     palm: _PalmSchema | None = None
+
+    @field_validator("slice_contour", mode="before")
+    @classmethod
+    def _slice(cls, value):
+        """Name the three values, rather than only the first the union tried (a boolean)."""
+        if not isinstance(value, bool) and value != "unbalanced":
+            raise ValueError(f'must be true, false or "unbalanced", got {value!r}')
+        return value
 
     @model_validator(mode="after")
     def _consistent(self):
@@ -236,6 +250,7 @@ def parse_hand(text: str, *, source: str = "<string>") -> Hand:
             max_imbalance=schema.max_imbalance,
             tips_brush_table=schema.tips_brush_table,
             grasp_height_fraction=schema.grasp_height_fraction,
+            slice_contour=schema.slice_contour,
             description=schema.description,
             chains=chains,
             palm=palm,
@@ -318,6 +333,8 @@ def hand_to_toml(hand: Hand, *, comment: str = "") -> str:
               f"tips_brush_table = {'true' if hand.tips_brush_table else 'false'}"]
     if hand.grasp_height_fraction != tol.GRASP_HEIGHT_FRACTION:  # written where it differs: absent reads as the default
         lines.append(f"grasp_height_fraction = {_float(hand.grasp_height_fraction)}")
+    if hand.slice_contour != "unbalanced":
+        lines.append(f"slice_contour = {str(hand.slice_contour).lower()}")
     for f in hand.fingers:
         lines += ["", "[[fingers]]", f"name = {_string(f.name)}", f"start = {_floats(f.start)}"]
         if isinstance(f.trajectory, Ray):

@@ -30,7 +30,8 @@ which is the thesis's setting)::
     descent = false              # the open 3-D hand's descent onto the height map (synthesis.Descent)
     grasp_height = "clearance"   # or "auto", or a height in m (synthesis.grasp_height)
     slice_contour = false        # plan on the cross-section at the grasp height (perception.cross_section);
-                                 # "unbalanced": only where the outline seen has no balanced squeeze
+                                 # "unbalanced": only where the outline seen has no balanced squeeze;
+                                 # "hand": the hand file's own (Hand.slice_contour)
     closing_sweep = false        # refuse poses where a finger's link meets the object before its tip (synthesis.sweep)
     closing_obstacles = false    # refuse poses where a closing finger runs into a neighbour or a bin wall
     small_objects = false        # fewer touching fingers where no pose satisfies the constraints (synthesis.search)
@@ -88,7 +89,7 @@ class _PlannerSchema(BaseModel):
     centring_gain: Annotated[float, Field(ge=0, le=tol.MAX_CENTRING_GAIN, allow_inf_nan=False)] | None = None
     max_imbalance: Literal["hand"] | Annotated[float, Field(ge=0, le=1, allow_inf_nan=False)] | None = None
     descent: bool | None = None
-    slice_contour: bool | Literal["unbalanced"] | None = None
+    slice_contour: bool | Literal["unbalanced", "hand"] | None = None
     closing_sweep: bool | None = None
     closing_obstacles: bool | None = None
     small_objects: bool | None = None
@@ -99,9 +100,9 @@ class _PlannerSchema(BaseModel):
     @field_validator("slice_contour", mode="before")
     @classmethod
     def _slice(cls, value):
-        """Name the three values, rather than only the first the union tried (a boolean)."""
-        if not isinstance(value, bool) and value != "unbalanced":
-            raise ValueError(f'must be true, false or "unbalanced", got {value!r}')
+        """Name the four values, rather than only the first the union tried (a boolean)."""
+        if not isinstance(value, bool) and value not in ("unbalanced", "hand"):
+            raise ValueError(f'must be true, false, "unbalanced" or "hand", got {value!r}')
         return value
 
     @field_validator("grasp_height", mode="before")

@@ -86,7 +86,7 @@ import mujoco  # noqa: E402
 from .. import tolerances as tol  # noqa: E402
 from .. import validation  # noqa: E402
 from ..errors import HandError, HandFileError, SimulationError  # noqa: E402
-from ..hand import Hand, Palm, SampledChain  # noqa: E402
+from ..hand import SLICE_CONTOUR, Hand, Palm, SampledChain  # noqa: E402
 from . import model_parts as parts  # noqa: E402
 from .calibrate import Closing, derive_virtual_starts  # noqa: E402
 from .model_fit import FingerFit, fit_chain, fit_finger, palm_plate, sampled_chain, travelled  # noqa: E402
@@ -131,11 +131,14 @@ class ModelSpec:
         The derived hand's :attr:`Hand.tips_brush_table`, chosen on the bench for the same reason.
     grasp_height_fraction : float
         The derived hand's :attr:`Hand.grasp_height_fraction`, chosen on the bench for the same reason.
+    slice_contour : bool or "unbalanced"
+        The derived hand's :attr:`Hand.slice_contour`, chosen on the bench for the same reason.
 
     Raises
     ------
     HandError
-        A ``max_imbalance`` or ``grasp_height_fraction`` out of range.
+        A ``max_imbalance`` or ``grasp_height_fraction`` out of range, a ``slice_contour`` not one of
+        :data:`~contourgrasp.hand.SLICE_CONTOUR`.
     """
 
     path: str
@@ -148,6 +151,7 @@ class ModelSpec:
     max_imbalance: float = tol.HAND_MAX_IMBALANCE
     tips_brush_table: bool = False
     grasp_height_fraction: float = tol.GRASP_HEIGHT_FRACTION
+    slice_contour: bool | str = "unbalanced"
 
     def __post_init__(self):
         # Checked as the Hand will check them, but before the model is closed for seconds.
@@ -155,6 +159,7 @@ class ModelSpec:
                            validation.bounded("max_imbalance", self.max_imbalance, 1.0, error=HandError))
         object.__setattr__(self, "grasp_height_fraction", validation.bounded(
             "grasp_height_fraction", self.grasp_height_fraction, tol.MAX_GRASP_HEIGHT_FRACTION, error=HandError))
+        validation.choice("slice_contour", self.slice_contour, SLICE_CONTOUR, error=HandError)
 
 
 def _bundled(folder: str, xml: str, fingers, **options) -> ModelSpec:
@@ -170,22 +175,24 @@ _INSPIRE_FINGERS = ("thumb", "index", "middle", "ring", "pinky")
 #: fingers each hold their own position: its squeeze's balance is off (max_imbalance 1), chosen on its ycb-train
 #: and thesis's-five trials (benchmarks/balance_sweep.md). The Inspire's fingertips brush the table
 #: (tips_brush_table), the Jaco's do not: chosen on the same trials (docs/hand3d.md, "The 3-D hand in the plan"). The
-#: Inspire's curling fingers are asked for no part of the object's height (grasp_height_fraction 0): chosen on its
-#: ycb-train trials (docs/hand-models.md, "The bench on the models").
+#: Inspire's curling fingers are asked for no part of the object's height (grasp_height_fraction 0) and are planned on
+#: the outline seen (slice_contour false): both chosen on its ycb-train trials (docs/hand-models.md, "The bench on the
+#: models").
 MODELS = {
     "inspire": _bundled(
         "inspire", "inspire_right_hand.xml", _INSPIRE_FINGERS, palm="r_palm",
         names=("thumb", "index", "middle", "ring", "little"),
         actuators=tuple(f"{f}_{j}_drive" for f in _INSPIRE_FINGERS[1:] for j in ("proximal", "distal"))
         + ("thumb_proximal_2_drive", "thumb_middle_drive", "thumb_distal_drive"),
-        hold=(("thumb_proximal_1_drive", 1.0),), approach=LEVEL, tips_brush_table=True, grasp_height_fraction=0.0),
+        hold=(("thumb_proximal_1_drive", 1.0),), approach=LEVEL, tips_brush_table=True, grasp_height_fraction=0.0,
+        slice_contour=False),
     "jaco-three-finger": _bundled("jaco_three_finger", "jaco_three_finger_gripper.xml", ("thumb", "index", "pinky"),
                                   palm="right_gripper", names=("thumb", "index", "pinky"), max_imbalance=1.0),
 }
 
 
 def model_spec(model, *, fingertips=None, actuators=None, palm=None, approach=None,
-               max_imbalance=None, tips_brush_table=None, grasp_height_fraction=None) -> ModelSpec:
+               max_imbalance=None, tips_brush_table=None, grasp_height_fraction=None, slice_contour=None) -> ModelSpec:
     """A :class:`ModelSpec` from a bundled model's name (:data:`MODELS`) or an MJCF path; options override.
 
     Raises
@@ -193,7 +200,7 @@ def model_spec(model, *, fingertips=None, actuators=None, palm=None, approach=No
     HandFileError
         A path without fingertips.
     HandError
-        A ``max_imbalance`` or ``grasp_height_fraction`` out of range.
+        A ``max_imbalance``, ``grasp_height_fraction`` or ``slice_contour`` the hand would refuse.
     """
     if isinstance(model, ModelSpec):
         spec = model
@@ -210,13 +217,9 @@ def model_spec(model, *, fingertips=None, actuators=None, palm=None, approach=No
         spec = replace(spec, actuators=tuple(actuators))
     if approach is not None:
         spec = replace(spec, approach=None if approach == ALONG_FINGERS else approach)
-    if max_imbalance is not None:
-        spec = replace(spec, max_imbalance=max_imbalance)
-    if tips_brush_table is not None:
-        spec = replace(spec, tips_brush_table=tips_brush_table)
-    if grasp_height_fraction is not None:
-        spec = replace(spec, grasp_height_fraction=grasp_height_fraction)
-    return replace(spec, palm=palm) if palm is not None else spec
+    chosen = {"max_imbalance": max_imbalance, "tips_brush_table": tips_brush_table,
+              "grasp_height_fraction": grasp_height_fraction, "slice_contour": slice_contour, "palm": palm}
+    return replace(spec, **{k: v for k, v in chosen.items() if v is not None})
 
 
 @dataclass(frozen=True)
@@ -309,15 +312,15 @@ class ClosedModel:
 
 
 def derive_hand(model, *, fingertips=None, actuators=None, palm=None, approach=None, max_imbalance=None,
-                tips_brush_table=None, grasp_height_fraction=None, name: str | None = None, close_time: float = 1.0,
-                hold_time: float = 0.5) -> Derivation:
+                tips_brush_table=None, grasp_height_fraction=None, slice_contour=None, name: str | None = None,
+                close_time: float = 1.0, hold_time: float = 0.5) -> Derivation:
     """Close a MuJoCo hand model with one synergy and fit its hand file (module docstring).
 
     Parameters
     ----------
     model : str, Path or ModelSpec
         A bundled model's name (:data:`MODELS`) or an MJCF file.
-    fingertips, actuators, palm, approach, max_imbalance, tips_brush_table, grasp_height_fraction
+    fingertips, actuators, palm, approach, max_imbalance, tips_brush_table, grasp_height_fraction, slice_contour
         Override the :class:`ModelSpec`'s (fingertips are required for a file).
     name : str, optional
         The hand's name; default the model file's stem.
@@ -341,7 +344,7 @@ def derive_hand(model, *, fingertips=None, actuators=None, palm=None, approach=N
     """
     spec = model_spec(model, fingertips=fingertips, actuators=actuators, palm=palm, approach=approach,
                       max_imbalance=max_imbalance, tips_brush_table=tips_brush_table,
-                      grasp_height_fraction=grasp_height_fraction)
+                      grasp_height_fraction=grasp_height_fraction, slice_contour=slice_contour)
     closed = close_model(spec, close_time=close_time, hold_time=hold_time)
     fingers, fits, ends = [], [], []
     for i, finger_name in enumerate(closed.names):
@@ -353,7 +356,7 @@ def derive_hand(model, *, fingertips=None, actuators=None, palm=None, approach=N
     default_name = str(model) if isinstance(model, str) and model in MODELS else Path(spec.path).stem
     hand = Hand(name=name or default_name, fingers=tuple(fingers), min_touching=_min_touching(len(fingers)),
                 miss_penalty=MISS_PENALTY, max_imbalance=spec.max_imbalance, tips_brush_table=spec.tips_brush_table,
-                grasp_height_fraction=spec.grasp_height_fraction,
+                grasp_height_fraction=spec.grasp_height_fraction, slice_contour=spec.slice_contour,
                 description=f"derived from {Path(spec.path).name} by hand-from-model")
     hand = _with_virtual_starts(hand, closed)
     hand, notes = _with_chains(hand, closed, ends)
