@@ -245,8 +245,7 @@ def plan_frame(
     spec = Descent(heights, *asked, sweep=sweep, closing=closing) if descent and asked is not None else None
     if validation.flag("low_objects", low_objects, error=PlannerError) and heights is not None:
         synthesis_options = {**synthesis_options, "low_object": bool(heights.max_height < tol.LOW_OBJECT_HEIGHT)}
-    slicing = bool(slice_contour) if isinstance(slice_contour, np.bool_) else slice_contour  # as flag() took them
-    slicing = validation.choice("slice_contour", slicing, SLICE_CONTOUR, error=PlannerError)
+    slicing = validation.choice("slice_contour", slice_contour, SLICE_CONTOUR, error=PlannerError)
     slicing = hand.slice_contour if slicing == "hand" else slicing
     section = perception.cross_section(heights, asked[0]) if slicing is True and asked is not None else None
     on_section = None

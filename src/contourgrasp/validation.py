@@ -80,7 +80,12 @@ def integer(name: str, value, minimum: int | None = None, *, maximum: int | None
 
 
 def choice(name: str, value, choices, *, error: type[InputError] = InputError):
-    """One of ``choices`` (compared with ==, so a string is never taken for a number)."""
+    """One of ``choices`` (compared with ==, so a string is never taken for a number; numpy's bool is a bool).
+
+    >>> choice("slice_contour", np.bool_(True), (False, True, "unbalanced"))
+    True
+    """
+    value = bool(value) if isinstance(value, np.bool_) else value
     if not any(type(value) is type(c) and value == c for c in choices):
         raise error(f"{name} must be one of {', '.join(map(repr, choices))}, got {value!r}")
     return value

@@ -144,9 +144,8 @@ class Hand:
         fraction = check.bounded(f"hand {self.name!r}: grasp_height_fraction", self.grasp_height_fraction,
                                  tol.MAX_GRASP_HEIGHT_FRACTION, "", error=HandError)
         object.__setattr__(self, "grasp_height_fraction", fraction)
-        slicing = bool(self.slice_contour) if isinstance(self.slice_contour, np.bool_) else self.slice_contour
-        object.__setattr__(self, "slice_contour", check.choice(f"hand {self.name!r}: slice_contour", slicing,
-                                                               SLICE_CONTOUR, error=HandError))
+        object.__setattr__(self, "slice_contour", check.choice(f"hand {self.name!r}: slice_contour",
+                                                               self.slice_contour, SLICE_CONTOUR, error=HandError))
         if len({f.name for f in self.fingers}) != n:
             raise HandError(f"hand {self.name!r}: finger names must be unique")
         self._check_body()

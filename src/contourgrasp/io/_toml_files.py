@@ -33,6 +33,22 @@ def read_spec(spec: str, folder: str, *, kind: str, error: type[Exception]) -> t
         raise error(f"{path}: cannot read {kind} file ({err.strerror or err})") from None
 
 
+def flag_or_word(value, words: tuple[str, ...]):
+    """``value``, a TOML boolean or one of ``words``; else a ValueError naming every value it may take.
+
+    For a schema's ``bool | Literal[...]`` field, whose union would name only the first type it tried (a boolean).
+
+    >>> flag_or_word("sometimes", ("unbalanced", "hand"))
+    Traceback (most recent call last):
+    ...
+    ValueError: must be true, false, "unbalanced" or "hand", got 'sometimes'
+    """
+    if not isinstance(value, bool) and value not in words:
+        allowed = ", ".join(["true", "false", *(f'"{w}"' for w in words[:-1])]) + f' or "{words[-1]}"'
+        raise ValueError(f"must be {allowed}, got {value!r}")
+    return value
+
+
 def parse_toml(text: str, source: str, *, error: type[Exception]) -> dict:
     """The TOML document ``text``; ``error`` names ``source`` when it is not valid TOML.
 

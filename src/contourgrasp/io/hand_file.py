@@ -185,10 +185,7 @@ class _HandSchema(_Strict):
     @field_validator("slice_contour", mode="before")
     @classmethod
     def _slice(cls, value):
-        """Name the three values, rather than only the first the union tried (a boolean)."""
-        if not isinstance(value, bool) and value != "unbalanced":
-            raise ValueError(f'must be true, false or "unbalanced", got {value!r}')
-        return value
+        return _toml_files.flag_or_word(value, ("unbalanced",))
 
     @model_validator(mode="after")
     def _consistent(self):

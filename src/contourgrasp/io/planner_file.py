@@ -100,10 +100,7 @@ class _PlannerSchema(BaseModel):
     @field_validator("slice_contour", mode="before")
     @classmethod
     def _slice(cls, value):
-        """Name the four values, rather than only the first the union tried (a boolean)."""
-        if not isinstance(value, bool) and value not in ("unbalanced", "hand"):
-            raise ValueError(f'must be true, false, "unbalanced" or "hand", got {value!r}')
-        return value
+        return _toml_files.flag_or_word(value, ("unbalanced", "hand"))
 
     @field_validator("grasp_height", mode="before")
     @classmethod

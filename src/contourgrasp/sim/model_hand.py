@@ -159,7 +159,8 @@ class ModelSpec:
                            validation.bounded("max_imbalance", self.max_imbalance, 1.0, error=HandError))
         object.__setattr__(self, "grasp_height_fraction", validation.bounded(
             "grasp_height_fraction", self.grasp_height_fraction, tol.MAX_GRASP_HEIGHT_FRACTION, error=HandError))
-        validation.choice("slice_contour", self.slice_contour, SLICE_CONTOUR, error=HandError)
+        object.__setattr__(self, "slice_contour",
+                           validation.choice("slice_contour", self.slice_contour, SLICE_CONTOUR, error=HandError))
 
 
 def _bundled(folder: str, xml: str, fingers, **options) -> ModelSpec:
