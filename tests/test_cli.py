@@ -325,7 +325,7 @@ def test_hand_from_model_writes_a_hand_that_plans(tmp_path, capsys, model):
 
 
 def test_hand_from_model_bad_input_is_one_line_and_writes_nothing(tmp_path, capsys):
-    model = Path(__file__).parent / "sim" / "fixtures" / "two-sliders.xml"
+    model = Path(__file__).parent / "handmodels" / "fixtures" / "two-sliders.xml"
     broken = tmp_path / "broken.xml"
     broken.write_text("<mujoco><worldbody><body></mujoco>")
     out = tmp_path / "hand.toml"

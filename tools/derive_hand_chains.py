@@ -1,7 +1,7 @@
 """Write the simulated hand's present geometry into the ray presets' hand files (issue 16, item 1.1).
 
 Each preset's 2-D fingers are given chains and a palm by
-``contourgrasp.sim.hand_model.derive_body`` with the default ``ChainRule`` -- exactly what
+``contourgrasp.sim.tendon_hand.derive_body`` with the default ``ChainRule`` -- exactly what
 ``build_hand`` built from the 2-D preset before the hand files carried their bodies -- and
 the ``[fingers.chain]`` and ``[palm]`` tables are written into the preset's TOML (comments
 kept; earlier generated tables replaced). Floats are written exactly (``repr``), so the
@@ -23,7 +23,7 @@ from pathlib import Path
 
 import contourgrasp
 from contourgrasp.io.hand_file import chain_toml, palm_toml, parse_hand
-from contourgrasp.sim.hand_model import derive_body
+from contourgrasp.sim.tendon_hand import derive_body
 
 PRESETS = ("five-finger-linear", "three-finger")
 HAND_DIR = Path(contourgrasp.__file__).parent / "data" / "hands"

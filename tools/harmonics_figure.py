@@ -32,7 +32,7 @@ import cv2
 import numpy as np
 from matplotlib.figure import Figure
 
-from contourgrasp import efd, example_contour, example_names, tolerances
+from contourgrasp import contour, example_contour, example_names, tolerances
 from contourgrasp.perception import mask_contour
 from contourgrasp.visualize import CONCAVE_COLOUR, CONVEX_COLOUR, draw_efd
 
@@ -70,16 +70,16 @@ def jittered(points: np.ndarray, sigma: float, rng: np.random.Generator, spacing
     normal = np.c_[tangent[:, 1], -tangent[:, 0]] / np.linalg.norm(tangent, axis=1)[:, None]
     for _ in range(1000):
         noisy = q + normal * rng.normal(0.0, sigma, (len(q), 1))
-        if efd.first_self_intersection(noisy) is None:
+        if contour.first_self_intersection(noisy) is None:
             return noisy
     raise RuntimeError(f"no simple polygon with {sigma} m of noise")
 
 
 def left_out(points: np.ndarray, upper: int = tolerances.HARMONICS_BOUNDS[1]) -> np.ndarray:
     """(upper + 1,) float: e(N) / sqrt(area) for N = 0..upper (the "rms" rule's measure)."""
-    power = efd.harmonic_power(efd.fit(points, upper))
+    power = contour.harmonic_power(contour.fit(points, upper))
     tail = np.append(np.cumsum(power[::-1])[::-1], 0.0)
-    return np.sqrt(tail / abs(efd.signed_area(efd.clean_polygon(points, check_units=False))))
+    return np.sqrt(tail / abs(contour.signed_area(contour.clean_polygon(points, check_units=False))))
 
 
 def sim_contours(names=SIM_OBJECTS, seeds=range(3)) -> dict[str, list[np.ndarray]]:
@@ -128,7 +128,7 @@ def sweep(draws: int = 5, sim: bool = False) -> str:
             cells = []
             for t in tols:
                 cells.append(" / ".join(
-                    _span([efd.choose_harmonics(p, rule=rule, tolerance=t) for p in by_kind[c]]) if c in by_kind else "-"
+                    _span([contour.choose_harmonics(p, rule=rule, tolerance=t) for p in by_kind[c]]) if c in by_kind else "-"
                     for c in columns))
             lines.append(f"| {name} | " + " | ".join(cells) + " |")
         lines.append("")
@@ -136,7 +136,7 @@ def sweep(draws: int = 5, sim: bool = False) -> str:
         lines.append("| contour | " + " | ".join(columns) + " |")
         lines.append("|---" * (len(columns) + 1) + "|")
         for name, by_kind in variants.items():
-            cells = [_span([efd.choose_harmonics(p, rule=rule) for p in by_kind[c]]) if c in by_kind else "-"
+            cells = [_span([contour.choose_harmonics(p, rule=rule) for p in by_kind[c]]) if c in by_kind else "-"
                      for c in columns]
             lines.append(f"| {name} | " + " | ".join(cells) + " |")
         lines.append("")
@@ -165,10 +165,10 @@ def figure() -> Figure:
     fig = Figure(figsize=(11.5, 3.3 * len(rows)), layout="constrained")
     axes = fig.subplots(len(rows), 3, width_ratios=[1, 1, 0.9])
     for (title, contour), (thesis_ax, adaptive_ax, error_ax) in zip(rows, axes):
-        contour = efd.clean_polygon(contour, check_units=False)
-        n = efd.choose_harmonics(contour)
+        contour = contour.clean_polygon(contour, check_units=False)
+        n = contour.choose_harmonics(contour)
         for ax, k, label in ((thesis_ax, 4, "thesis: 4 harmonics"), (adaptive_ax, n, f"adaptive: {n} harmonics")):
-            model = efd.fit(contour, k)
+            model = contour.fit(contour, k)
             ax.plot(*np.vstack([contour, contour[:1]]).T, color="0.7", lw=1)
             draw_efd(ax, model)
             runs = concave_runs(model)
@@ -196,7 +196,7 @@ def figure() -> Figure:
     thesis_ax.plot([], [], color=CONCAVE_COLOUR, lw=2, label="EFD concave")
     thesis_ax.plot([], [], color="0.7", lw=1, label="input polygon")
     thesis_ax.legend(fontsize=7, loc="lower left")
-    fig.suptitle("Adaptive harmonics (efd.choose_harmonics, 'rms' rule): the fewest N in "
+    fig.suptitle("Adaptive harmonics (contour.choose_harmonics, 'rms' rule): the fewest N in "
                  f"{lower}-{upper} whose left-out RMS detail\ne(N) = sqrt(P_N+1 + ... + P_{upper}) is at most "
                  f"{tolerance:g} x sqrt(area); concave stretches in blue (paper curvature), y down as the camera sees",
                  fontsize=10)

@@ -3,8 +3,7 @@
 The pipeline, one package or module per stage (thesis chapter 3):
 
 * :mod:`contourgrasp.perception` — RGB-D frame -> object contour in meters, height map (3.1)
-* :mod:`contourgrasp.contour` — contour model: Elliptic Fourier Descriptors, curvature (3.2);
-  :mod:`contourgrasp.efd` is its older name
+* :mod:`contourgrasp.contour` — contour model: Elliptic Fourier Descriptors, curvature (3.2)
 * :mod:`contourgrasp.hand` — finger trajectories, finger chains and hands (3.3)
 * :mod:`contourgrasp.synthesis` — inner and outer problems, the grasp plan (3.4)
 * :mod:`contourgrasp.quality` — force closure and the Ferrari-Canny epsilon (6.1 item 2)
@@ -26,7 +25,7 @@ from .errors import ContourError, HandFileError, InputError, NoFeasibleGrasp, Pl
 # The package's names load on first use (PEP 562), so that ``import contourgrasp`` and a CLI call pay
 # only for the stages they use: numba's kernels, scipy and pydantic cost tenths of a second to import.
 _LAZY = {
-    "efd": (".efd", None), "hand": (".hand", None), "synthesis": (".synthesis", None),
+    "contour": (".contour", None), "hand": (".hand", None), "synthesis": (".synthesis", None),
     "validation": (".validation", None), "EFD": (".contour", "EFD"), "GraspPlan": (".synthesis", "GraspPlan"),
     "Arc": (".hand", "Arc"), "Finger": (".hand", "Finger"), "Hand": (".hand", "Hand"), "Ray": (".hand", "Ray"),
     "FingerChain": (".hand", "FingerChain"), "Palm": (".hand", "Palm"), "SampledChain": (".hand", "SampledChain"),
@@ -51,7 +50,7 @@ def __dir__() -> list[str]:
     return sorted(set(globals()) | set(_LAZY))
 
 
-__version__ = "0.1.0"
+from ._version import __version__
 
 
 def synthesize(contour_xy, hand, *, planner=None, **options):
@@ -110,7 +109,7 @@ def plan_grasp(rgb, depth, intrinsics, hand="five-finger-linear", *, planner=Non
 
 __all__ = [
     "Arc", "ContourError", "EFD", "Finger", "FingerChain", "GraspPlan", "Hand", "HandFileError", "InputError",
-    "NoFeasibleGrasp", "Palm", "Ray", "SampledChain", "UnitWarning", "efd", "example_contour", "example_names", "hand",
+    "NoFeasibleGrasp", "Palm", "Ray", "SampledChain", "UnitWarning", "contour", "example_contour", "example_names", "hand",
     "load_hand", "load_planner", "plan_grasp", "planner_names", "preset_names", "read_contour", "synthesis",
     "synthesize",
 ]

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from . import __version__, synthesize
-from . import contour as efd
+from .contour import CURVATURE_MODES, clean_polygon, efd
 from .errors import DepthUnitWarning, InputError, NoFeasibleGrasp, OutputError
 from .io.contour_file import example_contour, example_names, read_contour
 from .io.hand_file import load_hand, preset_names
@@ -26,7 +26,7 @@ from .io.plan_file import atomic_outputs, plan_to_dict, write_json
 
 EXIT_OK, EXIT_INPUT, EXIT_INFEASIBLE = 0, 2, 3
 #: The palm axes hand-from-model and bench --hand-model accept as the approach, "level"
-#: (contourgrasp.sim.model_hand.LEVEL: the fingers' axis turned until the thumb's open tip is as deep as the others')
+#: (contourgrasp.handmodels.derive.LEVEL: the fingers' axis turned until the thumb's open tip is as deep as the others')
 #: and "fingers" (the axis the fingers point along, the default for a model file).
 APPROACHES = ("x", "-x", "y", "-y", "z", "-z", "level", "fingers")
 #: hand-from-model's --slice-contour: its words and the hand file's values (contourgrasp.hand.SLICE_CONTOUR).
@@ -176,7 +176,7 @@ def _parser() -> argparse.ArgumentParser:
     harm = sub.add_parser("efd", help="approximate a contour with several harmonic counts")
     harm.add_argument("--contour", required=True, help=contour_help)
     harm.add_argument("--harmonics", type=_positive_int, nargs="+", default=[1, 2, 4, 8])
-    harm.add_argument("--curvature", choices=efd.CURVATURE_MODES, default="paper")
+    harm.add_argument("--curvature", choices=CURVATURE_MODES, default="paper")
     harm.add_argument("--plot", help="write the figure (PNG) here")
     return parser
 
@@ -220,7 +220,7 @@ def _add_synthesis_options(parser) -> None:
                         help=f"planner preset ({', '.join(planner_names())}) or planner TOML file; "
                              "the options below override its settings")
     parser.add_argument("--harmonics", type=_harmonics, help="EFD harmonics, or 'adaptive'")
-    parser.add_argument("--curvature", choices=efd.CURVATURE_MODES)
+    parser.add_argument("--curvature", choices=CURVATURE_MODES)
     parser.add_argument("--xy-step", type=_positive_float, help="grid step in x and y, m")
     parser.add_argument("--yaw-step-deg", type=_positive_float, help="grid step in yaw, degrees")
     parser.add_argument("--d-max", type=_non_negative_float, nargs="+", metavar="D",
@@ -492,7 +492,7 @@ def _numbered(path: str, label: int, suffix: str) -> Path:
 
 
 def _bag_frame(args):
-    from .io.rosbag_file import read_bag_frame
+    from .ros.bag import read_bag_frame
 
     topics = {"--color-topic": args.color_topic, "--depth-topic": args.depth_topic, "--info-topic": args.info_topic}
     if missing := [name for name, topic in topics.items() if not topic]:
@@ -575,7 +575,7 @@ def _hand_model(args):
         return None
     if args.hand is not None:
         raise InputError("give --hand or --hand-model, not both (the model's hand file is derived from it)")
-    from .sim.model_mount import mount_model
+    from .handmodels import mount_model
 
     return mount_model(args.hand_model, fingertips=args.fingertips, actuators=args.actuators, palm=args.palm,
                        approach=args.approach)
@@ -599,7 +599,7 @@ def _calibrate(args) -> int:
 
 def _hand_from_model(args) -> int:
     from .io.hand_file import hand_to_toml
-    from .sim.model_hand import derive_hand, fit_table
+    from .handmodels import derive_hand, fit_table
 
     derivation = derive_hand(args.model, fingertips=args.fingertips, actuators=args.actuators, palm=args.palm,
                              approach=args.approach, max_imbalance=args.max_imbalance,
@@ -617,7 +617,7 @@ def _hand_from_model(args) -> int:
 
 
 def _efd(args) -> int:
-    contour = efd.clean_polygon(_contour(args.contour))
+    contour = clean_polygon(_contour(args.contour))
     for k in args.harmonics:
         model = efd.fit(contour, k)
         t, _ = efd.sample(model, 720)

@@ -273,11 +273,11 @@ CLOSED_WITHIN = 5e-4
 #: A simulated fingertip that has travelled this far has started to move, m.
 FINGER_MOVED = 1e-3
 
-#: Longest closing or hold of a hand model in free air (model_hand.derive_hand, model_force.fingertip_forces), s:
+#: Longest closing or hold of a hand model in free air (derive.derive_hand, force.fingertip_forces), s:
 #: a bound on the simulation an argument can ask for (the defaults are 1-3 s).
 MAX_MODEL_CLOSING_TIME = 60.0
 
-#: model_force.fingertip_forces: a fingertip slower than this has no direction of motion to push along
+#: force.fingertip_forces: a fingertip slower than this has no direction of motion to push along
 #: (stopped at a joint limit, say), m/s; a 3 s closing moves the bundled models' tips at 20-40 mm/s.
 FINGERTIP_MOVING = 1e-3
 
@@ -366,7 +366,7 @@ PALM_PLANARITY = 1e-4
 MAX_CHAIN_SAMPLES = 201
 MAX_CHAIN_POINTS = 8
 
-#: Samples of a chain measured on a hand model (sim.model_hand): evenly in the tip's travel, close
+#: Samples of a chain measured on a hand model (handmodels.derive): evenly in the tip's travel, close
 #: enough that the linear interpolation between them stays within a few hundredths of a millimetre
 #: of the arcs the bundled models' tips follow.
 MODEL_CHAIN_SAMPLES = 41
@@ -459,7 +459,7 @@ SWEEP_TOLERANCE = 0.005
 VERTICAL_AXIS = 1e-12
 
 
-# --- hand models (sim.model_hand) ---
+# --- hand models (handmodels.derive) ---
 
 #: Largest distance (m) of a MuJoCo model's fingertip path, projected on the palm plane, from the ray or
 #: elliptic arc fitted to it; a finger fitting neither within this is refused by hand-from-model.

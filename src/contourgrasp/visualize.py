@@ -16,7 +16,7 @@ from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 from mpl_toolkits.axes_grid1.anchored_artists import AnchoredSizeBar
 
-from . import contour as efd_model
+from .contour import clean_polygon, efd
 from .hand import chain_capsules, chain_plane, to_image
 from .synthesis import GraspPlan
 
@@ -27,10 +27,10 @@ SIDE_VIEW_LINK_WIDTH = 4.0
 FINGER_COLOURS = ("tab:red", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink", "tab:olive")
 
 
-def draw_efd(ax, model: efd_model.EFD, *, curvature: str = "paper", samples: int = 720, linewidth: float = 2.0):
+def draw_efd(ax, model: efd.EFD, *, curvature: str = "paper", samples: int = 720, linewidth: float = 2.0):
     """Draw the EFD curve on ``ax`` with concave stretches coloured."""
-    t, points = efd_model.sample(model, samples)
-    concave = efd_model.concave(model, t, curvature)
+    t, points = efd.sample(model, samples)
+    concave = efd.concave(model, t, curvature)
     closed = np.vstack([points, points[:1]])
     segments = np.stack([closed[:-1], closed[1:]], axis=1)
     colours = np.where(concave, CONCAVE_COLOUR, CONVEX_COLOUR)
@@ -128,12 +128,12 @@ def harmonics_figure(contour_xy, harmonics: Sequence[int] = (1, 2, 4, 8), *, cur
     matplotlib.figure.Figure
         The scale bar's length follows the contour's size (2 cm for the thesis's objects).
     """
-    contour = efd_model.clean_polygon(contour_xy, check_units=False)
+    contour = clean_polygon(contour_xy, check_units=False)
     scale = _scale_bar(float(np.max(np.ptp(contour, axis=0))))
     fig = Figure(figsize=(3.2 * len(harmonics), 3.6), layout="constrained")
     axes = fig.subplots(1, len(harmonics), sharex=True, sharey=True, squeeze=False)[0]
     for ax, k in zip(axes, harmonics):
-        model = efd_model.fit(contour, k)
+        model = efd.fit(contour, k)
         ax.plot(*np.vstack([contour, contour[:1]]).T, color="0.7", lw=1)
         draw_efd(ax, model, curvature=curvature)
         ax.set_title(f"{k} harmonic{'s' if k > 1 else ''}")

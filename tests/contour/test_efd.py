@@ -189,15 +189,13 @@ def test_an_unchecked_overflowing_polygon_is_a_contour_error_not_nan():
         contour.fit(example_contour("can") * 1e155, validate=False)
 
 
-# --- the public name contourgrasp.efd -----------------------------------------------------------------
+# --- the package's one public name ------------------------------------------------------------------
 
-def test_contourgrasp_efd_is_the_contour_package():
-    from contourgrasp.efd import EFD, choose_harmonics, fit  # noqa: F401  (README's import)
-
-    assert contourgrasp.efd.__all__ == contour.__all__
-    for name in contour.__all__:
-        assert getattr(contourgrasp.efd, name) is getattr(contour, name)
-    assert contourgrasp.efd.choose_harmonics(example_contour("stone2")) == 8
+def test_the_contour_model_has_one_public_name():
+    assert contourgrasp.contour is contour
+    assert contourgrasp.contour.choose_harmonics(example_contour("stone2")) == 8
+    with pytest.raises(AttributeError):
+        contourgrasp.efd  # noqa: B018
 
 
 @settings(max_examples=80, deadline=None)

@@ -12,7 +12,7 @@ from contourgrasp import (
     Finger,
     Hand,
     Ray,
-    efd,
+    contour,
     example_contour,
     load_hand,
     preset_names,
@@ -48,7 +48,7 @@ def test_a_can_at_the_grasp_centre_is_touched_by_every_finger(name):
     can = example_contour("can")
     touched_by_all = []
     for angle in np.radians(np.arange(0, 180, 5)):
-        model = efd.fit(can @ rotation(angle).T + hand.grasp_centre)
+        model = contour.fit(can @ rotation(angle).T + hand.grasp_centre)
         result = synthesis.evaluate_poses(model, hand, [[0.0, 0.0, 0.0]])
         touched_by_all.append(bool(result.touching.all() and not result.start_inside.any()))
     assert any(touched_by_all)

@@ -8,19 +8,19 @@ import pytest
 from contourgrasp import InputError, load_hand
 from contourgrasp.cli import main
 from contourgrasp.io.hand_file import hand_to_toml
-from contourgrasp.sim.calibrate import CLOSED_WITHIN, Closing, calibrate_virtual_starts, derive_virtual_starts
+from contourgrasp.sim.calibrate import CLOSED_WITHIN, FingerTravel, calibrate_virtual_starts, derive_virtual_starts
 
 TRAVEL = 0.05
 TIMES = np.linspace(0.0, 2.0, 2001)
 
 
-def linear_closing(speeds, delays=None) -> Closing:
+def linear_closing(speeds, delays=None) -> FingerTravel:
     """Fingers of equal travel closing at constant speeds (m/s) after delays (s), stopping at full travel."""
     speeds = np.asarray(speeds, dtype=float)
     delays = np.zeros_like(speeds) if delays is None else np.asarray(delays, dtype=float)
     travelled = np.minimum(speeds[:, None] * np.maximum(TIMES - delays[:, None], 0.0), TRAVEL)
     names = tuple(f"f{i}" for i in range(len(speeds)))
-    return Closing(names=names, travel=np.full(len(speeds), TRAVEL), times=TIMES, travelled=travelled)
+    return FingerTravel(names=names, travel=np.full(len(speeds), TRAVEL), times=TIMES, travelled=travelled)
 
 
 def test_constant_speeds_give_the_analytic_offsets():

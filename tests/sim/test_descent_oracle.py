@@ -18,7 +18,7 @@ import pytest
 
 from contourgrasp import load_hand, pipeline
 from contourgrasp.hand import to_image
-from contourgrasp.sim.model_mount import mount_model
+from contourgrasp.handmodels.mount import mount_model
 from contourgrasp.sim.objects import soda_can
 from contourgrasp.sim.render import render
 from contourgrasp.sim.scene import build_scene

@@ -48,7 +48,7 @@ def test_random_pose_is_feasible_and_seeded():
     poses = [random_feasible_pose(contour, HAND, np.random.default_rng(seed), settings) for seed in (0, 0, 1)]
     np.testing.assert_array_equal(poses[0], poses[1])
     assert not np.array_equal(poses[0], poses[2])
-    model = contourgrasp.efd.fit(contourgrasp.efd.clean_polygon(contour), settings["harmonics"])
+    model = contourgrasp.contour.fit(contourgrasp.contour.clean_polygon(contour), settings["harmonics"])
     assert evaluate_poses(model, HAND, np.array(poses), d_min=settings["grid"].d_min).feasible.all()
 
 

@@ -6,12 +6,12 @@ import numpy as np
 import pytest
 
 import contourgrasp as cg
-from contourgrasp import efd, synthesis
+from contourgrasp import contour, synthesis
 
 
 def test_printed_linear_ratio_cost_sums_to_zero_for_every_pose():
     hand = cg.load_hand("five-finger-linear")
-    model = efd.fit(cg.example_contour("can"))
+    model = contour.fit(cg.example_contour("can"))
     grid = synthesis.SearchGrid(xy_step=0.05, yaw_step=math.radians(10))
     result = synthesis.evaluate_poses(model, hand, grid.poses(model.locus))
     beta = np.full(len(hand.fingers), 1e4)

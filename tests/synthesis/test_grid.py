@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import contourgrasp as cg
-from contourgrasp import efd, synthesis
+from contourgrasp import contour, synthesis
 from contourgrasp.synthesis import _grid_kernels
 from conftest import disc, rotate
 
@@ -18,10 +18,10 @@ def test_compiled_grid_screen_matches_the_numpy_inner_problem(hand, steps):
     """Same polygon, same arithmetic: the filtered kernel must find exactly what brute force finds
     (edge groups in buckets on the finer grid, scanned on the coarser one)."""
     hand = cg.load_hand(hand)
-    model = efd.fit(cg.example_contour("stone1"))
+    model = contour.fit(cg.example_contour("stone1"))
     grid = synthesis.SearchGrid(xy_step=steps[0], yaw_step=math.radians(steps[1]))
     screen = synthesis.screen_grid(model, hand, grid)
-    t, polygon = efd.sample(model)
+    t, polygon = contour.sample(model)
     lam, t_hit, _, inside = synthesis.first_touch(polygon, t, model.T, hand.segments(), len(hand.fingers), screen.poses)
     np.testing.assert_array_equal(screen.start_inside, inside)
     np.testing.assert_array_equal(screen.touching, np.isfinite(lam))
@@ -40,7 +40,7 @@ def test_compiled_grid_screen_matches_the_numpy_inner_problem(hand, steps):
 @pytest.mark.parametrize("touching", [1, 3])
 def test_the_reaching_screen_is_the_full_screen_where_enough_fingers_touch(touching):
     hand = dataclasses.replace(cg.load_hand("five-finger-linear"), min_touching=touching)
-    model = efd.fit(cg.example_contour("stone1"))
+    model = contour.fit(cg.example_contour("stone1"))
     grid = synthesis.SearchGrid(xy_step=0.03, yaw_step=math.radians(7))
     full = synthesis.screen_grid(model, hand, grid)
     reaching, counts, any_outside = synthesis.screen_reaching(model, hand, grid)
@@ -59,9 +59,9 @@ def test_curved_thumb_cells_match_brute_force_on_a_large_and_a_tiny_object():
     grid = synthesis.SearchGrid(xy_step=0.03, yaw_step=math.radians(9))
     # turned off the grid's axes: a symmetric disc would put rays exactly through polygon vertices
     for outline in (rotate(disc(0.14, n=90) * [1.0, 0.6], 0.3), rotate(disc(0.012, n=40) * [1.0, 0.7], 0.3)):
-        model = efd.fit(outline)
+        model = contour.fit(outline)
         screen = synthesis.screen_grid(model, hand, grid)
-        t, polygon = efd.sample(model)
+        t, polygon = contour.sample(model)
         lam, t_hit, _, inside = synthesis.first_touch(polygon, t, model.T, hand.segments(), 5, screen.poses)
         assert np.isfinite(lam[:, 0]).any()
         np.testing.assert_array_equal(screen.start_inside, inside)
@@ -70,16 +70,16 @@ def test_curved_thumb_cells_match_brute_force_on_a_large_and_a_tiny_object():
         np.testing.assert_allclose(screen.t[screen.touching], t_hit[np.isfinite(lam)], atol=1e-12)
 
 
-@pytest.mark.parametrize("mode", efd.CURVATURE_MODES)
+@pytest.mark.parametrize("mode", contour.CURVATURE_MODES)
 def test_screen_curvature_tables_match_the_curve(mode):
     """Magnitude and turning sign interpolated apart: no smearing across the paper curvature's jumps."""
-    model = efd.fit(cg.example_contour("peanut"))
+    model = contour.fit(cg.example_contour("peanut"))
     t = np.random.default_rng(3).uniform(0, model.T, (2000, 1))
     table_t = np.linspace(0.0, model.T, cg.tolerances.CURVATURE_TABLE, endpoint=False)
-    d1, d2 = efd.evaluate(model, table_t, 1), efd.evaluate(model, table_t, 2)
-    table = _grid_kernels.interpolate_curvature(np.abs(efd.curvature(model, table_t, mode)),
+    d1, d2 = contour.evaluate(model, table_t, 1), contour.evaluate(model, table_t, 2)
+    table = _grid_kernels.interpolate_curvature(np.abs(contour.curvature(model, table_t, mode)),
                                            d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0], t, model.T)[:, 0]
-    exact = efd.curvature(model, t[:, 0], mode)
+    exact = contour.curvature(model, t[:, 0], mode)
     assert (exact < 0).any() and (exact > 0).any()
     assert np.mean(np.sign(table) == np.sign(exact)) > 0.998
     same = np.sign(table) == np.sign(exact)

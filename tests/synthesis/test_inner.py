@@ -7,7 +7,7 @@ import pytest
 from matplotlib.path import Path as MplPath
 
 import contourgrasp as cg
-from contourgrasp import efd, synthesis
+from contourgrasp import contour, synthesis
 from contourgrasp.hand import to_image
 from contourgrasp.synthesis import _derived, _touch_kernels
 from conftest import disc
@@ -15,7 +15,7 @@ from conftest import disc
 
 def test_centred_three_finger_grasp_on_a_disc_is_symmetric():
     hand = cg.load_hand("three-finger")
-    model = efd.fit(disc(0.03))
+    model = contour.fit(disc(0.03))
     result = synthesis.evaluate_poses(model, hand, [[0.0, 0.0, 0.3]])
     assert result.touching.all() and result.feasible[0]
     np.testing.assert_allclose(result.lam[0], np.linalg.norm(hand.starts, axis=1) - 0.03, atol=1e-4)
@@ -31,7 +31,7 @@ def test_closest_approach_of_a_finger_passing_beside_a_disc(chords):
     # The index's ray passes 3 cm from the centre of a 2 cm disc, nearest at its middle: 1 cm gap
     # there, the nearest contour point on the circle, and that point the caller's own.
     finger = cg.load_hand("five-finger-linear").fingers[1]
-    model = efd.fit(disc(0.02))
+    model = contour.fit(disc(0.02))
     a, b = to_image(finger.points(np.array([0.0, finger.travel])), np.zeros(3))
     direction = (b - a) / np.linalg.norm(b - a)
     pose = np.r_[0.03 * np.array([-direction[1], direction[0]]) - (a + b) / 2, 0.0]
@@ -46,8 +46,8 @@ def test_closest_approach_of_a_finger_passing_beside_a_disc(chords):
 
 def test_first_touch_matches_brute_force_marching():
     hand = cg.load_hand("five-finger-linear")
-    model = efd.fit(cg.example_contour("peanut"))
-    _, polygon = efd.sample(model, 8192)  # the curve itself, for practical purposes
+    model = contour.fit(cg.example_contour("peanut"))
+    _, polygon = contour.sample(model, 8192)  # the curve itself, for practical purposes
     inside = MplPath(polygon)
     rng = np.random.default_rng(0)
     poses = np.c_[rng.uniform(-0.15, 0.15, (40, 2)), rng.uniform(0, 2 * math.pi, 40)]
@@ -69,8 +69,8 @@ def test_first_touch_matches_brute_force_marching():
 def test_compiled_pose_list_matches_the_numpy_inner_problem():
     """evaluate_poses's polygon stage (every chord against every edge, compiled) is first_touch's answer."""
     for hand in map(cg.load_hand, cg.preset_names()):
-        model = efd.fit(cg.example_contour("peanut"))
-        t, polygon = efd.sample(model)
+        model = contour.fit(cg.example_contour("peanut"))
+        t, polygon = contour.sample(model)
         rng = np.random.default_rng(2)
         poses = np.c_[rng.uniform(-0.12, 0.12, (300, 2)), rng.uniform(0, 2 * math.pi, 300)]
         seg = hand.segments()
@@ -102,8 +102,8 @@ def test_nearest_point_segment_matches_numpy(seed):
 
 def test_start_inside_matches_point_in_polygon():
     hand = cg.load_hand("five-finger-linear")
-    model = efd.fit(cg.example_contour("case") * 2.5)
-    _, polygon = efd.sample(model)
+    model = contour.fit(cg.example_contour("case") * 2.5)
+    _, polygon = contour.sample(model)
     rng = np.random.default_rng(1)
     poses = np.c_[rng.uniform(-0.2, 0.2, (300, 2)), rng.uniform(0, 2 * math.pi, 300)]
     result = synthesis.evaluate_poses(model, hand, poses)

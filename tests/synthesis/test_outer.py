@@ -10,7 +10,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import contourgrasp as cg
-from contourgrasp import ContourError, NoFeasibleGrasp, efd
+from contourgrasp import ContourError, NoFeasibleGrasp, contour
 from conftest import disc, rotate
 
 
@@ -127,7 +127,7 @@ def test_geometric_curvature_mode_runs_and_reports_it():
     plan = cg.synthesize(cg.example_contour("case"), "three-finger", curvature="geometric", yaw_step=math.radians(6))
     assert plan.curvature_mode == "geometric"
     for f in plan.fingers:
-        assert f.concave == (efd.curvature(plan.efd, [f.t], "geometric")[0] < 0)
+        assert f.concave == (contour.curvature(plan.efd, [f.t], "geometric")[0] < 0)
 
 
 @pytest.mark.parametrize("option, value", [("xy_step", 0.0), ("yaw_step", -1.0), ("d_min", -0.1), ("top_k", 0),
@@ -315,7 +315,7 @@ def test_the_small_object_rule_closes_fingertip_balls_on_an_object_the_points_ca
         cg.synthesize(small, _pincer(0.006), small_objects=False, **grid)
     plan = cg.synthesize(small, _pincer(0.006), small_objects=True, **grid)
     assert plan.grown == 0.006 and "grown by 6.0 mm" in plan.notes[-1]
-    assert np.array_equal(plan.contour, efd.clean_polygon(small))
+    assert np.array_equal(plan.contour, contour.clean_polygon(small))
     for finger in plan.fingers:  # each tip's centre stops one radius off the object: 5 + 6 mm from its centre
         assert not finger.missed and np.linalg.norm(finger.grasp_point) == pytest.approx(0.011, abs=2e-4)
     with pytest.raises(NoFeasibleGrasp, match=r"as balls \(the outline grown by 6.0 mm\): no pose brings 2"):
@@ -331,7 +331,7 @@ def test_widening_the_exact_evaluation_evaluates_each_pose_once_and_keeps_the_fu
     from contourgrasp.synthesis.safeguards import Safeguards
 
     hand, grid = cg.load_hand("five-finger-linear"), SearchGrid(**FINE)
-    model = efd.fit(cg.example_contour("can"), 4)
+    model = contour.fit(cg.example_contour("can"), 4)
     screen = screen_grid(model, hand, grid)
     cheapest = np.flatnonzero(screen.feasible)[np.argsort(screen.cost[screen.feasible], kind="stable")]
     refused = {tuple(p) for p in screen.poses[cheapest[:10]]}  # the 10 cheapest fail exactly: the set must widen twice

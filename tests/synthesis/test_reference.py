@@ -1,40 +1,36 @@
 """The library's grid search finds the same optimum as the thesis's nested optimisation.
 
-``benchmarks/reference_nested.py`` solves the inner problem of every pose and finger with scipy's
+``contourgrasp.synthesis.reference`` solves the inner problem of every pose and finger with scipy's
 L-BFGS-B, as the thesis does; the library screens the grid with a compiled kernel on the EFD polygon
 and re-evaluates the best candidates exactly. On a small grid (xy 0.05 m, yaw 30 deg, D_max 0.10 m:
 5 x 5 x 12 = 300 poses, a few seconds of reference per case) both must find the same best cost within
 1e-6 relative and the same number of feasible poses; refining that optimum continuously never makes it
 worse. Correctness only: speed is measured by ``benchmarks/search_speed.py``.
 
-peanut / five-finger-curved-thumb, asked for by issue 5, has no feasible pose on any grid this small
-(its 14 feasible poses on the thesis grid need the 2-degree yaw step), so stone1 stands in for it with
-the curved-thumb hand.
+peanut / five-finger-curved-thumb has no feasible pose on any grid this small (its 14 feasible poses
+on the thesis grid need the 2-degree yaw step), so stone1 stands in for it with the curved-thumb hand.
 """
 
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import contourgrasp as cg
-from contourgrasp import efd, synthesis
+from contourgrasp import contour, synthesis
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
-from reference_nested import reference_search  # noqa: E402
+from contourgrasp.synthesis.reference import reference_search
 
 GRID = {"xy_step": 0.05, "yaw_step": math.radians(30), "d_max": (0.10, 0.10), "d_min": 0.015}
 REL = 1e-6
 
 
 @pytest.mark.parametrize(
-    "contour, hand",
+    "name, hand",
     [("can", "three-finger"), ("stone1", "five-finger-linear"), ("stone1", "five-finger-curved-thumb")],
 )
-def test_best_cost_and_feasible_count_match_the_nested_reference(contour, hand):
-    outline = cg.example_contour(contour)
+def test_best_cost_and_feasible_count_match_the_nested_reference(name, hand):
+    outline = cg.example_contour(name)
     plan = cg.synthesize(outline, hand, **GRID)
     ref_pose, ref_cost, ref_feasible = reference_search(outline, cg.load_hand(hand), **GRID)
     assert ref_pose is not None, "the reference finds no feasible pose: pick a case feasible on this grid"
@@ -50,7 +46,7 @@ def test_best_cost_and_feasible_count_match_the_nested_reference(contour, hand):
     # within that error of D_min. None occurs on this grid; the exact evaluation of every grid pose
     # (contacts moved onto the curve by Newton) must agree with the reference as well.
     assert plan.feasible_poses == ref_feasible
-    model = efd.fit(efd.clean_polygon(outline), 4)
+    model = contour.fit(contour.clean_polygon(outline), 4)
     grid = synthesis.SearchGrid(**GRID)
     exact = synthesis.evaluate_poses(model, cg.load_hand(hand), grid.poses(model.locus), d_min=grid.d_min)
     assert int(exact.feasible.sum()) == ref_feasible

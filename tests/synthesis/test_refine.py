@@ -6,14 +6,14 @@ import numpy as np
 import pytest
 
 import contourgrasp as cg
-from contourgrasp import efd, synthesis
+from contourgrasp import contour, synthesis
 from contourgrasp.io.plan_file import plan_to_dict
 from contourgrasp.synthesis import outer
 
 
 def _grid_best(outline, hand, top=4, **grid):
     """The model and the exact evaluation of the ``top`` distinct best poses of a grid."""
-    model = efd.fit(outline)
+    model = contour.fit(outline)
     grid = synthesis.SearchGrid(**grid)
     screen = synthesis.screen_grid(model, hand, grid)
     best = outer._reevaluate_best(model, hand, screen, 40, "paper", grid.d_min, synthesis.Safeguards())
@@ -53,7 +53,7 @@ def test_refinement_applies_the_evaluation_keywords():
 @pytest.mark.parametrize("option, value", [("step", (0.0, 0.1)), ("step", (0.05,)), ("halvings", -1),
                                            ("rounds", 2.5), ("d_max", -0.1)])
 def test_refinement_refuses_bad_options(option, value):
-    model = efd.fit(cg.example_contour("can"))
+    model = contour.fit(cg.example_contour("can"))
     with pytest.raises(cg.InputError):
         synthesis.refine_poses(model, cg.load_hand("three-finger"), [[0.0, 0.0, 0.0]], **{option: value})
 

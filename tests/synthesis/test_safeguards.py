@@ -73,7 +73,7 @@ def test_thick_fingers_start_clear_of_the_contour():
     contour = cg.example_contour("can")
     hand = cg.load_hand("five-finger-linear")
     plan = cg.synthesize(contour, hand, finger_thickness=True, clearance=0.005, **FAST)
-    samples = cg.efd.sample(plan.efd, 2048)[1]
+    samples = cg.contour.sample(plan.efd, 2048)[1]
     for finger, contact in zip(hand.fingers, plan.fingers, strict=True):
         gap = np.linalg.norm(samples - contact.start, axis=1).min()
         assert gap >= finger.radius + 0.005 - 1e-4
@@ -231,7 +231,7 @@ def test_two_opposed_fingers_balance_a_disc():
 
 def test_the_screens_compiled_balance_is_the_squeezes_on_a_disc_and_equals_it_on_any_contour():
     radius = 0.04
-    disc = cg.efd.fit(circle(radius), harmonics=1)
+    disc = cg.contour.fit(circle(radius), harmonics=1)
     at = np.radians([[180, -60, -20, 20, 60], [0, 180, 0, 0, 0], [90, 0, 0, 0, 0], [0, 0, 0, 0, 0]])
     t = np.mod(at, 2 * np.pi) * disc.T / (2 * np.pi) + 0.0  # the fit starts at angle 0, counter-clockwise
     touching = np.array([[1, 1, 1, 1, 1], [1, 1, 0, 0, 0], [1, 0, 0, 0, 0], [0, 0, 0, 0, 0]], bool)
@@ -239,7 +239,7 @@ def test_the_screens_compiled_balance_is_the_squeezes_on_a_disc_and_equals_it_on
     # the thumb against four fingers over 120 deg (quality.imbalance's example), an opposed pair, one finger, none
     assert share == pytest.approx([0.376, 0.0, 1.0, 1.0], abs=1e-3)
     theta = np.linspace(0, 2 * np.pi, 400, endpoint=False)
-    blob = cg.efd.fit(np.c_[(0.05 + 0.01 * np.cos(3 * theta)) * np.cos(theta), 0.03 * np.sin(theta)], harmonics=12)
+    blob = cg.contour.fit(np.c_[(0.05 + 0.01 * np.cos(3 * theta)) * np.cos(theta), 0.03 * np.sin(theta)], harmonics=12)
     rng = np.random.default_rng(0)
     t, touching = rng.uniform(0, blob.T, (500, 5)), rng.random((500, 5)) < 0.7
     assert contact_imbalance(blob.coefficients, blob.T, t, touching, 1e-12) == pytest.approx(
@@ -283,7 +283,7 @@ def test_the_centring_gain_adds_its_cost_and_brings_the_object_to_the_pinch_cent
     contour, hand = cg.example_contour("bottle"), cg.load_hand("five-finger-linear")
     plain = cg.synthesize(contour, hand, **FAST)
     centred = cg.synthesize(contour, hand, centring_gain=1000.0, **FAST)
-    locus = cg.efd.fit(contour, 4).locus
+    locus = cg.contour.fit(contour, 4).locus
     def distance(plan):
         return float(centring_distance(hand, np.array([plan.pose]), locus)[0])
     assert distance(centred) <= distance(plain) and distance(centred) < 0.02  # within a grid step of it

@@ -7,8 +7,6 @@
   :func:`curvature`, :func:`concave` (eq 3.3-3.17)
 * :mod:`~contourgrasp.contour.harmonics` — the adaptive number of harmonics
   (:func:`choose_harmonics`, :func:`fit_adaptive`; thesis 6.1 item 3)
-
-Its public name is :mod:`contourgrasp.efd`, which re-exports all of it.
 """
 
 from .efd import (CURVATURE_MODES, EFD, CurvatureMode, concave, curvature, curvature_from_derivatives, evaluate,

@@ -55,7 +55,7 @@ class FingerChain:
     ``q(s) = open_angles + s * (closed_angles - open_angles)``. This is how the simulated hand's
     tendon closes a free finger: each joint's preloaded spring balances the tendon torque, so both
     joints move linearly in the tendon force between the finger's start and end force, their
-    ratio fixed (``contourgrasp.sim.hand_model``); ``s`` is that fraction of the way.
+    ratio fixed (``contourgrasp.sim.tendon_hand``); ``s`` is that fraction of the way.
 
     A finger that leans outward by ``tilt`` when open has ``open_angles = (-tilt, 0)``, and its
     knuckle lies ``(l1 + l2) * sin(tilt)`` inward of its open tip along ``direction``.
@@ -167,7 +167,7 @@ class Palm:
     """The palm: a plate whose underside is the planar polygon ``outline``, ``thickness`` above it.
 
     The underside lies at z = 0 (the palm plane) unless ``depths`` tilts or lowers it: a hand model's
-    palm read :data:`~contourgrasp.sim.model_hand.LEVEL` is tilted, and part of it lies below the
+    palm read :data:`~contourgrasp.handmodels.derive.LEVEL` is tilted, and part of it lies below the
     shallowest knuckle, where z = 0 is.
 
     Attributes
@@ -402,7 +402,7 @@ def check_chain(finger: Finger, chain: FingerChain | SampledChain) -> None:
     every one of ``tolerances.CHAIN_SAMPLES`` progresses evenly spaced in [0, 1]
     (:func:`chain_deviation`). A :class:`SampledChain` is held to ``tolerances.MODEL_FIT_TOLERANCE``
     (3 mm) instead: it is a hand model's finger as measured, and its trajectory a ray or arc fitted
-    to that same path within that tolerance (:mod:`contourgrasp.sim.model_fit`), so the measured
+    to that same path within that tolerance (:mod:`contourgrasp.handmodels.fit`), so the measured
     finger is refused only where the fit would be. The chain's radius must be the finger's ``radius``.
 
     Raises

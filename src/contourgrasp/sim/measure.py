@@ -5,7 +5,7 @@ How well the simulated hand follows its 2-D preset: fingertip paths closing in f
 The synthesis assumes each fingertip's projection onto the image plane moves on
 the segment ``start -> start + travel * closing_direction`` (eq 3.18). The
 simulated fingers are planar chains built to do so (see
-:mod:`contourgrasp.sim.hand_model`); what can still pull a tip off the segment
+:mod:`contourgrasp.sim.tendon_hand`); what can still pull a tip off the segment
 is dynamics: the soft joint limits the tip overshoots at the end, the base
 servo giving way to the fingers' reaction, joint compliance. These functions
 measure it.
@@ -25,7 +25,7 @@ import mujoco  # noqa: E402
 
 from ..errors import SimulationError  # noqa: E402
 from ..hand import polyline_distance  # noqa: E402
-from .hand_model import HandDesign  # noqa: E402
+from .tendon_hand import HandDesign  # noqa: E402
 from .objects import ObjectSpec, Part  # noqa: E402
 from .scene import IMPRATIO, build_scene, grip_contact, solver_option  # noqa: E402
 

@@ -46,7 +46,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from .. import contour as efd
+from ..contour import clean_polygon, fit
 from .. import perception, pipeline, synthesis
 from ..errors import HandError, NoFeasibleGrasp, SimulationError
 from ..hand import Hand, Ray, to_image
@@ -278,7 +278,7 @@ def random_feasible_pose(contour_xy, hand: Hand, rng: np.random.Generator, setti
     NoFeasibleGrasp
         None of ``RANDOM_BATCH * RANDOM_BATCHES`` poses drawn is feasible.
     """
-    model = efd.fit(efd.clean_polygon(contour_xy), settings["harmonics"], validate=False)
+    model = fit(clean_polygon(contour_xy), settings["harmonics"], validate=False)
     grid = settings["grid"]
     xs, ys, _ = grid.axes(model.locus)
     low, high = np.array([xs[0], ys[0], 0.0]), np.array([xs[-1], ys[-1], 2 * math.pi])

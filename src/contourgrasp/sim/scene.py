@@ -52,7 +52,7 @@ from ..hand import Hand  # noqa: E402
 from ..perception import Intrinsics  # noqa: E402
 from ..io.hand_file import load_hand  # noqa: E402
 from ..tolerances import NEIGHBOUR_LIFT, SENSOR_RANGE  # noqa: E402
-from .hand_model import HAND_BIT, TABLE_BIT, HandDesign, HandModel, build_hand  # noqa: E402
+from .tendon_hand import HAND_BIT, TABLE_BIT, HandDesign, HandModel, build_hand  # noqa: E402
 from .objects import ObjectSpec, Part, object_spec  # noqa: E402
 
 #: Simulation step, s.
@@ -212,7 +212,7 @@ class Scene:
         self._base_qpos = np.array([model.joint(j).qposadr[0] for j in BASE_JOINTS])
         self._base_ctrl = np.array([model.actuator(j).id for j in BASE_JOINTS])
         self._base_dofs = np.array([model.joint(j).dofadr[0] for j in BASE_JOINTS])
-        synergy = getattr(hand, "synergy", None)  # a mounted hand model (sim.model_mount) closes many actuators
+        synergy = getattr(hand, "synergy", None)  # a mounted hand model (handmodels.mount) closes many actuators
         self._closing = synergy(model) if synergy else (np.array([model.actuator("flexion").id]), np.zeros(1),
                                                         np.ones(1))
         for actuator, value in getattr(hand, "held", lambda _: [])(model):
@@ -343,9 +343,9 @@ def build_scene(obj, *, seed: int, hand: Hand | str = "five-finger-linear", desi
         Chooses the placement.
     hand : Hand, str or MountedHand
         A preset name, hand TOML path or :class:`Hand` with ray fingers; or a hand model mounted
-        by :func:`~contourgrasp.sim.model_mount.mount_model`, simulated as itself.
+        by :func:`~contourgrasp.handmodels.mount.mount_model`, simulated as itself.
     design, timing
-        See :func:`~contourgrasp.sim.hand_model.build_hand`.
+        See :func:`~contourgrasp.sim.tendon_hand.build_hand`.
     camera : Camera
     workspace : Workspace
     """

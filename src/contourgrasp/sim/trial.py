@@ -69,7 +69,7 @@ import numpy as np
 from ..errors import InputError, NoFeasibleGrasp, SimulationError
 from ..hand import Hand
 from .clutter import build_clutter, target_pixel
-from .hand_model import HandDesign
+from .tendon_hand import HandDesign
 from .render import render
 from .scene import Camera, Scene, Workspace, build_scene
 
@@ -220,7 +220,7 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
     noise : DepthNoise or bool
         Sensor noise of the picture (see :func:`~contourgrasp.sim.render.render`).
     timing, design
-        Finger closing schedule and hand parameters (:mod:`contourgrasp.sim.hand_model`).
+        Finger closing schedule and hand parameters (:mod:`contourgrasp.sim.tendon_hand`).
     camera, workspace, execution
         Scene and execution parameters.
     observe : callable, optional

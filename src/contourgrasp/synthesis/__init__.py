@@ -20,13 +20,13 @@
 :func:`contourgrasp.synthesize` is :func:`search` with a hand and a planner given by name.
 """
 
-from .cost import distance, ratio_cost
+from .cost import PoseEvaluation, distance, ratio_cost
 from .descent import Descent, DescentCheck, descent_clearance, descent_feasible, descent_floor
 from .evaluate import evaluate_poses
 from .grid import SearchGrid, distinct_best, screen_grid, screen_reaching
 from .inner import closest_approach, first_touch
 from .outer import search
-from .plan import Alternative, Cost, FingerContact, GraspPlan, PoseEvaluation, Refinement
+from .plan import Alternative, Cost, FingerContact, GraspPlan, Refinement
 from .refine import refine_poses
 from .safeguards import Safeguards, fingers_clear, grasp_epsilon, grasp_imbalance
 

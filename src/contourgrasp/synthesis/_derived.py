@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import contour as efd_model
+from ..contour import sample
 from .. import tolerances as tol
 from ..contour import EFD
 from ..hand import Hand, HandSegments, Ray
@@ -34,8 +34,8 @@ def cached(owner, kind, build):
 
 
 def polygon(model: EFD, samples: int = tol.EFD_SAMPLES) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`contourgrasp.efd.sample` of ``model``, computed once per model and count (:func:`cached`)."""
-    return cached(model, ("polygon", samples), lambda: read_only(*efd_model.sample(model, samples)))
+    """:func:`contourgrasp.contour.sample` of ``model``, computed once per model and count (:func:`cached`)."""
+    return cached(model, ("polygon", samples), lambda: read_only(*sample(model, samples)))
 
 
 def read_only(*arrays: np.ndarray) -> tuple[np.ndarray, ...]:

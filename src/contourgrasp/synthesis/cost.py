@@ -3,7 +3,7 @@
 The cost of a pose has three parts, summed over touching fingers i:
 
 * curvature: alpha_i * C(t_i), with C the signed curvature of
-  :func:`contourgrasp.efd.curvature` (concave points lower the cost);
+  :func:`contourgrasp.contour.curvature` (concave points lower the cost);
 * ratio: beta_i * (dist_i - mean_{j != i} dist_j)^2, with dist the distance
   from the finger's virtual start to its grasp point (eq 3.35-3.36) and the
   mean over the other touching fingers. Eq 3.35 prints the deviation
@@ -20,6 +20,7 @@ The per-pose loops are compiled (:mod:`contourgrasp.synthesis._cost_kernels`).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
@@ -29,8 +30,68 @@ from ..errors import PlannerError
 from ..hand import Hand
 from ._cost_kernels import centring_distances, ratio_cost_rows, score_poses
 from ._derived import hand_arrays
-from .plan import PoseEvaluation
 from .safeguards import Safeguards
+
+
+@dataclass(frozen=True, eq=False)
+class PoseEvaluation:
+    """Inner-problem solutions and costs for many poses; arrays are (p,) or (p, n_fingers).
+
+    Attributes
+    ----------
+    poses : (p, 3) float
+    touching : (p, f) bool
+        The finger meets the contour within its travel.
+    lam : (p, f) float
+        Distance travelled to the grasp point, m (NaN where missed).
+    t : (p, f) float
+        EFD parameter of the grasp point (NaN where missed).
+    grasp_point : (p, f, 2) float
+        Image-plane grasp point, m (NaN where missed).
+    distance : (p, f) float
+        dist(t, lambda_virt) of eq 3.36: virtual start to grasp point, m.
+    start_distance : (p, f) float
+        dist(t, 0): actual start to grasp point, m (eq 3.41).
+    curvature : (p, f) float
+        Signed curvature at the grasp point (NaN where missed).
+    start_inside : (p, f) bool
+        The fingertip starts inside the contour.
+    starts_outside : (p,) bool
+        No fingertip starts inside the contour.
+    reaches : (p,) bool
+        Every required finger and at least ``min_touching`` fingers touch.
+    clear : (p,) bool
+        The fingers pass :class:`Safeguards` ``finger_thickness`` (all True when it is off).
+    epsilon : (p,) float
+        Ferrari-Canny epsilon of the grasp points (NaN where not computed).
+    imbalance : (p,) float
+        The squeeze's imbalance at the grasp points (:func:`contourgrasp.quality.imbalance`; NaN
+        where not computed).
+    feasible : (p,) bool
+    cost_curvature, cost_ratio, cost_miss, cost_quality, cost_centring, cost : (p,) float
+    """
+
+    poses: np.ndarray
+    touching: np.ndarray
+    lam: np.ndarray
+    t: np.ndarray
+    grasp_point: np.ndarray
+    distance: np.ndarray
+    start_distance: np.ndarray
+    curvature: np.ndarray
+    start_inside: np.ndarray
+    starts_outside: np.ndarray
+    reaches: np.ndarray
+    clear: np.ndarray
+    epsilon: np.ndarray
+    imbalance: np.ndarray
+    feasible: np.ndarray
+    cost_curvature: np.ndarray
+    cost_ratio: np.ndarray
+    cost_miss: np.ndarray
+    cost_quality: np.ndarray
+    cost_centring: np.ndarray
+    cost: np.ndarray
 
 
 def ratio_cost(

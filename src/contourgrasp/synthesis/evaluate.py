@@ -6,7 +6,7 @@ from dataclasses import fields
 
 import numpy as np
 
-from .. import contour as efd_model
+from ..contour import CURVATURE_MODES, efd
 from .. import tolerances as tol
 from .. import validation as check
 from ..contour import EFD, CurvatureMode
@@ -15,7 +15,7 @@ from ..hand import Hand
 from ._derived import polygon
 from .cost import score
 from .inner import solve
-from .plan import PoseEvaluation
+from .cost import PoseEvaluation
 from .safeguards import Safeguards, fingers_clear, grade
 
 
@@ -58,7 +58,7 @@ def evaluate_poses(
     PlannerError
         Naming the option that is malformed.
     """
-    check.choice("curvature", curvature, efd_model.CURVATURE_MODES, error=PlannerError)
+    check.choice("curvature", curvature, CURVATURE_MODES, error=PlannerError)
     check.bounded("d_min", d_min, tol.MAX_SEARCH_LENGTH, " m", error=PlannerError)
     check.integer("samples", samples, 3, error=PlannerError)
     if not isinstance(safeguards, Safeguards):
@@ -67,7 +67,7 @@ def evaluate_poses(
     lam, t, point, start_inside = solve(model, hand, poses, samples)
     touching = np.isfinite(lam)
     curv = np.full(lam.shape, np.nan)
-    curv[touching] = efd_model.curvature(model, t[touching], curvature)
+    curv[touching] = efd.curvature(model, t[touching], curvature)
     clear = np.ones(len(poses), bool)
     if safeguards.finger_thickness:
         contour = polygon(model, samples)[1]

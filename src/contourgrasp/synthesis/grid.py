@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import contour as efd_model
+from ..contour import curvature_from_derivatives, evaluate_derivatives
 from .. import tolerances as tol
 from .. import validation as check
 from ..contour import EFD, CurvatureMode
@@ -20,8 +20,7 @@ from ..errors import PlannerError
 from ..hand import Hand
 from ._derived import hand_arrays, polygon
 from ._grid_kernels import grid_first_touch, interpolate_curvature, touch_counts
-from .cost import score
-from .plan import PoseEvaluation
+from .cost import PoseEvaluation, score
 from .safeguards import Safeguards
 
 
@@ -181,9 +180,9 @@ def _first_touches(model: EFD, hand: Hand, grid: SearchGrid, curvature: Curvatur
     # The paper's curvature jumps where the contour turns from convex to concave; its magnitude and
     # the turning direction r' x r'' do not, so they are tabulated and interpolated apart.
     table_t = np.linspace(0.0, model.T, tol.CURVATURE_TABLE, endpoint=False)
-    d1, d2 = efd_model.evaluate_derivatives(model, table_t, (1, 2))
+    d1, d2 = evaluate_derivatives(model, table_t, (1, 2))
     turn = d1[:, 0] * d2[:, 1] - d1[:, 1] * d2[:, 0]
-    magnitude = np.abs(efd_model.curvature_from_derivatives(d1, d2, model.T, curvature))
+    magnitude = np.abs(curvature_from_derivatives(d1, d2, model.T, curvature))
     return grid.poses(model.locus), (lam, t, point, start_inside), (magnitude, turn), len(yaws)
 
 

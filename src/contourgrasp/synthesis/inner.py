@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import contour as efd_model
+from ..contour import evaluate, evaluate_derivatives
 from .. import tolerances as tol
 from ..contour import EFD
 from ..hand import Hand, HandSegments, rotation, to_image
@@ -176,7 +176,7 @@ def newton(model: EFD, hand: Hand, poses, t, lam, point, touching, t_step, itera
     paths = _Paths(hand, fingers)
     for _ in range(iterations):
         local, direction = paths.at(lam_i)
-        r, dr = efd_model.evaluate_derivatives(model, t_i, (0, 1))
+        r, dr = evaluate_derivatives(model, t_i, (0, 1))
         F = residual(r, xy, R, local)
         dp = np.einsum("pij,pj->pi", R, direction)
         det = -dr[:, 0] * dp[:, 1] + dp[:, 0] * dr[:, 1]
@@ -187,7 +187,7 @@ def newton(model: EFD, hand: Hand, poses, t, lam, point, touching, t_step, itera
         if not (np.abs(step_t) > 1e-12).any() and not (np.abs(step_lam) > 1e-12).any():
             break
     local, _ = paths.at(lam_i, tangents=False)
-    r = efd_model.evaluate(model, t_i)
+    r = evaluate(model, t_i)
     gap = np.linalg.norm(residual(r, xy, R, local), axis=1)
     travel = hand_arrays(hand).travel[fingers]
     ok = (gap < 1e-9) & (lam_i >= 0) & (lam_i <= travel) & (np.abs(t_i - t[rows, fingers]) < 2 * t_step)

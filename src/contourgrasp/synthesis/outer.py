@@ -27,22 +27,21 @@ from typing import Callable, Literal
 
 import numpy as np
 
-from .. import contour as efd_model
 from .. import quality
 from .. import tolerances as tol
 from .. import validation as check
-from ..contour import EFD, CurvatureMode
+from ..contour import CURVATURE_MODES, EFD, CurvatureMode, choose_harmonics, clean_polygon, efd, grow_polygon
 from ..errors import HandError, NoFeasibleGrasp, PlannerError
 from ..hand import Hand, to_image
 from ._cost_kernels import contact_imbalance
 from ._derived import hand_arrays
-from .cost import distance
+from .cost import PoseEvaluation, distance
 from .descent import (Descent, DescentCheck, blocked_by_obstacles, body_names, check_candidates, descent_feasible,
                       descends_clear)
 from .evaluate import concatenate, evaluate_poses
 from .grid import SearchGrid, distinct_best, screen_reaching
 from .inner import closest_approach
-from .plan import Alternative, Cost, FingerContact, GraspPlan, PoseEvaluation, Refinement
+from .plan import Alternative, Cost, FingerContact, GraspPlan, Refinement
 from .refine import refine_poses
 from .safeguards import Safeguards, grasp_epsilon, grasp_imbalance
 
@@ -85,9 +84,9 @@ def search(
         (:func:`contourgrasp.synthesize` also takes a preset name or a TOML path.)
     harmonics : int or "adaptive"
         EFD harmonics (thesis: 4; at most ``tolerances.MAX_HARMONICS``); ``"adaptive"`` chooses
-        them per object (:func:`contourgrasp.efd.choose_harmonics` with its defaults).
+        them per object (:func:`contourgrasp.contour.choose_harmonics` with its defaults).
     curvature : {"paper", "geometric"}
-        Curvature flavour of the cost, see :mod:`contourgrasp.efd`.
+        Curvature flavour of the cost, see :mod:`contourgrasp.contour`.
     xy_step, yaw_step : float
         Grid resolution, m and rad (Table 4.1: 0.05 m, 2 deg).
     d_max : float or (2,) float
@@ -170,7 +169,7 @@ def search(
     >>> [f.missed for f in plan.fingers]
     [False, False, False]
     """
-    check.choice("curvature", curvature, efd_model.CURVATURE_MODES, error=PlannerError)
+    check.choice("curvature", curvature, CURVATURE_MODES, error=PlannerError)
     _check_harmonics(harmonics)
     check.integer("top_k", top_k, 1, maximum=tol.MAX_GRID_POSES, error=PlannerError)
     refine = check.flag("refine", refine, error=PlannerError)
@@ -192,7 +191,7 @@ def search(
     clock = time.perf_counter()
     small_objects = check.flag("small_objects", small_objects, error=PlannerError)
     preferred = not check.flag("balance_required", balance_required, error=PlannerError)
-    contour = efd_model.clean_polygon(contour_xy)
+    contour = clean_polygon(contour_xy)
     if balanced_alternative is not None and not callable(balanced_alternative):
         raise PlannerError(f"balanced_alternative must be callable, got {type(balanced_alternative).__name__}")
     elsewhere = _Elsewhere(balanced_alternative)
@@ -224,7 +223,7 @@ def search(
 def _grown(contour, radius: float) -> np.ndarray:
     """The outline a fingertip ball's centre meets: ``contour`` grown by ``radius``, cleaned (the one gate every
     outline passes before its fit: growth can triple a jagged outline's vertices)."""
-    return efd_model.clean_polygon(efd_model.grow_polygon(contour, radius), check_units=False)
+    return clean_polygon(grow_polygon(contour, radius), check_units=False)
 
 
 def _as_balls(plan: GraspPlan, contour, radius: float, note: str) -> GraspPlan:
@@ -246,8 +245,8 @@ def _search_outline(contour, *, hand: Hand, grid: SearchGrid, safeguards: Safegu
     Raises :class:`_OutOfReach` when, with the fewest touching fingers tried, no pose brings them onto the
     object within their travel."""
     if harmonics == "adaptive":
-        harmonics = efd_model.choose_harmonics(contour, validate=False)
-    model = efd_model.fit(contour, harmonics, validate=False)
+        harmonics = choose_harmonics(contour, validate=False)
+    model = efd.fit(contour, harmonics, validate=False)
     fitted = time.perf_counter()
     fewest = _fewest_touching(hand) if small_objects else hand.min_touching
     counts = range(hand.min_touching, fewest - 1, -1)
@@ -619,7 +618,7 @@ def _contacts(model: EFD, hand: Hand, result: PoseEvaluation, i: int, mode: Curv
             found.append((result.t[i, f], result.lam[i, f], result.grasp_point[i, f], 0.0))
         else:
             found.append(closest_approach(model, finger, pose))
-    curvatures = efd_model.curvature(model, [t for t, *_ in found], mode)
+    curvatures = efd.curvature(model, [t for t, *_ in found], mode)
     contacts = []
     for f, (finger, (t, lam, point, gap), kappa) in enumerate(zip(hand.fingers, found, curvatures.tolist())):
         missed = not result.touching[i, f]

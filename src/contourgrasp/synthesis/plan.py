@@ -17,67 +17,6 @@ if TYPE_CHECKING:
     from .descent import DescentCheck
 
 
-@dataclass(frozen=True, eq=False)
-class PoseEvaluation:
-    """Inner-problem solutions and costs for many poses; arrays are (p,) or (p, n_fingers).
-
-    Attributes
-    ----------
-    poses : (p, 3) float
-    touching : (p, f) bool
-        The finger meets the contour within its travel.
-    lam : (p, f) float
-        Distance travelled to the grasp point, m (NaN where missed).
-    t : (p, f) float
-        EFD parameter of the grasp point (NaN where missed).
-    grasp_point : (p, f, 2) float
-        Image-plane grasp point, m (NaN where missed).
-    distance : (p, f) float
-        dist(t, lambda_virt) of eq 3.36: virtual start to grasp point, m.
-    start_distance : (p, f) float
-        dist(t, 0): actual start to grasp point, m (eq 3.41).
-    curvature : (p, f) float
-        Signed curvature at the grasp point (NaN where missed).
-    start_inside : (p, f) bool
-        The fingertip starts inside the contour.
-    starts_outside : (p,) bool
-        No fingertip starts inside the contour.
-    reaches : (p,) bool
-        Every required finger and at least ``min_touching`` fingers touch.
-    clear : (p,) bool
-        The fingers pass :class:`Safeguards` ``finger_thickness`` (all True when it is off).
-    epsilon : (p,) float
-        Ferrari-Canny epsilon of the grasp points (NaN where not computed).
-    imbalance : (p,) float
-        The squeeze's imbalance at the grasp points (:func:`contourgrasp.quality.imbalance`; NaN
-        where not computed).
-    feasible : (p,) bool
-    cost_curvature, cost_ratio, cost_miss, cost_quality, cost_centring, cost : (p,) float
-    """
-
-    poses: np.ndarray
-    touching: np.ndarray
-    lam: np.ndarray
-    t: np.ndarray
-    grasp_point: np.ndarray
-    distance: np.ndarray
-    start_distance: np.ndarray
-    curvature: np.ndarray
-    start_inside: np.ndarray
-    starts_outside: np.ndarray
-    reaches: np.ndarray
-    clear: np.ndarray
-    epsilon: np.ndarray
-    imbalance: np.ndarray
-    feasible: np.ndarray
-    cost_curvature: np.ndarray
-    cost_ratio: np.ndarray
-    cost_miss: np.ndarray
-    cost_quality: np.ndarray
-    cost_centring: np.ndarray
-    cost: np.ndarray
-
-
 @dataclass(frozen=True)
 class Cost:
     """The cost of a pose (see eq 3.34) and its parts (``quality``, ``centring``: :class:`Safeguards`' gains)."""

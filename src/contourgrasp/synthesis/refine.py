@@ -12,7 +12,7 @@ from ..contour import EFD
 from ..errors import PlannerError
 from ..hand import Hand
 from .evaluate import evaluate_poses, replace_rows
-from .plan import PoseEvaluation
+from .cost import PoseEvaluation
 
 
 def refine_poses(

@@ -10,7 +10,7 @@ from ...hand import Hand
 from ...io.hand_file import load_hand
 from ...validation import choice, integer
 from ..clutter import SCENE_KINDS
-from ..hand_model import build_hand
+from ..tendon_hand import build_hand
 from ..objects import THESIS_OBJECTS, ObjectSpec, object_spec
 from ..planners import BASELINES, make_planner, synthesis_planner
 from ..scene import Camera, Workspace
@@ -51,7 +51,7 @@ class Bench:
         their objects, for the per-split report; empty: no split, the thesis's
         report.
     hand_model : MountedHand, optional
-        A MuJoCo hand model simulated as itself (:func:`~contourgrasp.sim.model_mount.mount_model`);
+        A MuJoCo hand model simulated as itself (:func:`~contourgrasp.handmodels.mount.mount_model`);
         ``hand`` is then its derived hand file. None: the simulated hand is built from ``hand``.
     scene_kind : {"single", "clutter", "bin"}
         The scene of every trial (:mod:`contourgrasp.sim.clutter`). In

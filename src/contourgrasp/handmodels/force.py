@@ -1,6 +1,6 @@
 """How hard each fingertip of a MuJoCo hand model pushes along its closing path.
 
-The model is closed as :mod:`contourgrasp.sim.model_hand` closes it to derive a hand file (its
+The model is closed as :mod:`contourgrasp.handmodels.derive` closes it to derive a hand file (its
 docstring: palm fixed, gravity and contacts off, the synergy ramped from open to closed), and the
 drives' joint forces are read part way through. Not part of the hand file: the planner's squeeze
 balance takes every finger as pushing equally hard (docs/hand-models.md, "The bench on the models", and
@@ -20,8 +20,8 @@ import mujoco  # noqa: E402
 from .. import tolerances as tol  # noqa: E402
 from .. import validation  # noqa: E402
 from ..errors import HandError  # noqa: E402
-from .model_hand import free_air_closing, model_spec  # noqa: E402
-from .model_parts import load_model  # noqa: E402
+from .derive import simulate_closing, model_spec  # noqa: E402
+from .lookup import load_model  # noqa: E402
 
 #: Where along the synergy's ramp :func:`fingertip_forces` reads the forces by default.
 FORCE_PROGRESS = (0.4, 0.6, 0.8)
@@ -31,7 +31,7 @@ def fingertip_forces(model, *, fingertips=None, actuators=None, palm=None, progr
                      close_time: float = 3.0) -> dict[float, dict[str, float]]:
     """How hard each fingertip of a hand model pushes along its closing path, N, at points of the closing.
 
-    The model is closed in free air as :func:`~contourgrasp.sim.model_hand.derive_hand` closes it (palm fixed,
+    The model is closed in free air as :func:`~contourgrasp.handmodels.derive.derive_hand` closes it (palm fixed,
     gravity and contacts off, the synergy ramped from open to closed over ``close_time``, held
     pre-shapes kept). At each fraction ``progress`` of the ramp, every synergy actuator is commanded
     fully closed for an instant and the joint forces it then applies, ``tau``, are read; a fingertip's
@@ -44,7 +44,7 @@ def fingertip_forces(model, *, fingertips=None, actuators=None, palm=None, progr
     Parameters
     ----------
     model : str, Path or ModelSpec
-        As :func:`~contourgrasp.sim.model_hand.derive_hand`; ``fingertips``, ``actuators`` and ``palm`` override
+        As :func:`~contourgrasp.handmodels.derive.derive_hand`; ``fingertips``, ``actuators`` and ``palm`` override
         its spec.
     progress : sequence of float
         Fractions of the ramp, each in (0, 1].
@@ -60,7 +60,7 @@ def fingertip_forces(model, *, fingertips=None, actuators=None, palm=None, progr
     Raises
     ------
     HandFileError, HandError, SimulationError
-        As :func:`~contourgrasp.sim.model_hand.derive_hand`; HandError also for a ``progress`` outside (0, 1]
+        As :func:`~contourgrasp.handmodels.derive.derive_hand`; HandError also for a ``progress`` outside (0, 1]
         or none, or a ``close_time`` out of range.
 
     Examples
@@ -74,7 +74,7 @@ def fingertip_forces(model, *, fingertips=None, actuators=None, palm=None, progr
     if not fractions:
         raise HandError("progress must name at least one fraction of the closing")
     m = load_model(spec.path)
-    run, acts, held, lo, hi, _ = free_air_closing(m, spec, close_time, 0.0)
+    run, acts, held, lo, hi, _ = simulate_closing(m, spec, close_time, 0.0)
     names = spec.names or spec.fingertips
     settle, ramp, _ = run.steps
     steps = {p: settle + round(p * ramp) for p in fractions}

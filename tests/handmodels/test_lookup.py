@@ -1,11 +1,11 @@
-"""The parts of a hand model found by name (contourgrasp.sim.model_parts), on a small model whose answers are known."""
+"""The parts of a hand model found by name (contourgrasp.handmodels.lookup), on a small model whose answers are known."""
 
 import mujoco
 import numpy as np
 import pytest
 
 from contourgrasp.errors import HandFileError
-from contourgrasp.sim import model_parts as parts
+from contourgrasp.handmodels import lookup as parts
 
 #: A palm on a free base (an arm's stand-in) with two two-hinge fingers; the right tip is a box, the left a ball.
 HAND = """<mujoco>

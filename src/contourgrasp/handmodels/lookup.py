@@ -1,4 +1,4 @@
-"""The parts of a MuJoCo hand model that :mod:`contourgrasp.sim.model_hand` reads, by name.
+"""The parts of a MuJoCo hand model that :mod:`contourgrasp.handmodels.derive` reads, by name.
 
 The palm body and the bodies below it, the fingertips (sites or bodies), the synergy's actuators and
 the pre-shape's, each finger's hinge joints, and the collision geoms' boxes that give the palm's
@@ -18,8 +18,8 @@ os.environ.setdefault("MUJOCO_GL", "disable")
 import mujoco  # noqa: E402
 
 from ..errors import HandFileError  # noqa: E402
-from .model_fit import BOX_CORNERS  # noqa: E402
-from .scene import mujoco_warnings  # noqa: E402
+from .fit import BOX_CORNERS  # noqa: E402
+from ..sim.scene import mujoco_warnings  # noqa: E402
 
 
 def load_model(path) -> mujoco.MjModel:

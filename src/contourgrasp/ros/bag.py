@@ -14,9 +14,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import InputError
-from ..ros import messages
-from ..ros.pairing import PAIR_TOLERANCE, nearest
-from .camera_file import RGBDFrame
+from . import messages
+from .pairing import PAIR_TOLERANCE, nearest
+from ..io.camera_file import RGBDFrame
 
 IMAGE, CAMERA_INFO = "sensor_msgs/msg/Image", "sensor_msgs/msg/CameraInfo"
 

@@ -1,9 +1,9 @@
 import numpy as np
 import pytest
 
-from contourgrasp.sim.model_hand import MODELS
-from contourgrasp.sim.model_parts import geom_corners
-from contourgrasp.sim.model_mount import PREFIX, mount_model
+from contourgrasp.handmodels.derive import MODELS
+from contourgrasp.handmodels.lookup import geom_corners
+from contourgrasp.handmodels.mount import PREFIX, mount_model
 from contourgrasp.sim.objects import soda_can
 from contourgrasp.sim.planners import make_planner
 from contourgrasp.sim.scene import build_scene

@@ -69,11 +69,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import tolerances as tol
-from . import validation as check
-from ._quality_kernels import ball_radii
-from .contour import EFD, evaluate
-from .errors import QualityError
+from .. import tolerances as tol
+from .. import validation as check
+from ._kernels import ball_radii
+from ..contour import EFD, evaluate
+from ..errors import QualityError
 
 METRICS: tuple[str, ...] = ("L1", "Linf")
 
@@ -287,7 +287,7 @@ def contour_normals(model: EFD, t) -> np.ndarray:
     Parameters
     ----------
     model : EFD
-        A model from :func:`contourgrasp.efd.fit`.
+        A model from :func:`contourgrasp.contour.fit`.
     t : (...) float
         Curve parameters (arc length, meters).
 

@@ -1,12 +1,12 @@
-"""The compiled ball radius of contourgrasp._quality_kernels against Qhull and against every plane tried."""
+"""The compiled ball radius of contourgrasp.quality._kernels against Qhull and against every plane tried."""
 
 import itertools
 
 import numpy as np
 
-from contourgrasp import quality as q
+from contourgrasp.quality import wrench_space as q
 from contourgrasp import tolerances as tol
-from contourgrasp._quality_kernels import ball_radii
+from contourgrasp.quality._kernels import ball_radii
 
 
 def _every_plane(w, ok):

@@ -1,6 +1,6 @@
 """Fitting a model's measured closing with the thesis's trajectories (3.3) and a finger's planar chain.
 
-Pure numpy on the paths :mod:`contourgrasp.sim.model_hand` records (its docstring has the reading of
+Pure numpy on the paths :mod:`contourgrasp.handmodels.derive` records (its docstring has the reading of
 the model): :func:`fit_finger` fits a projected fingertip path with a ray (eq 3.18) or, when the ray
 leaves it by more than ``tolerances.MODEL_FIT_TOLERANCE``, an axis-aligned elliptic arc (eq 3.20,
 a least-squares conic); :func:`travelled` reads a path as distances along the fitted trajectory;

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from contourgrasp.errors import HandError
-from contourgrasp.sim.model_force import fingertip_forces
+from contourgrasp.handmodels.force import fingertip_forces
 
 #: A hinged lever 0.05 m long driven at 0.2 N m and a slider driven at 3 N, both saturated (see the file).
 LEVER_AND_SLIDER = Path(__file__).parent / "fixtures" / "lever-and-slider.xml"

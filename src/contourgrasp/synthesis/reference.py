@@ -14,8 +14,8 @@ outer cost (eq 3.34, squared ratio as in the library) and constraints
 evaluated pose by pose in plain Python. Slow on purpose: it is what the
 library must agree with.
 
-This is not part of the library; ``benchmarks/search_speed.py`` and
-``tests/synthesis/test_reference.py`` use it.
+Not imported by :mod:`contourgrasp.synthesis`: ``benchmarks/search_speed.py`` measures the search's
+speed against it, and ``tests/synthesis/test_reference.py`` checks the search's answers against it.
 """
 
 from __future__ import annotations
@@ -26,9 +26,9 @@ import numpy as np
 from matplotlib.path import Path as MplPath
 from scipy.optimize import minimize
 
-from contourgrasp import efd
-from contourgrasp.hand import Hand, to_image
-from contourgrasp.synthesis import SearchGrid
+from ..contour import clean_polygon, efd
+from ..hand import Hand, to_image
+from .grid import SearchGrid
 
 TOUCH = 1e-7  # m: the solver's residual distance below which a finger touches
 MARCH = 201
@@ -66,7 +66,7 @@ def solve_inner(model: efd.EFD, finger, pose, outline: MplPath, curve: np.ndarra
 def reference_search(contour_xy, hand: Hand, *, harmonics=4, curvature="paper", xy_step=0.05,
                      yaw_step=math.radians(2), d_max=(0.15, 0.15), d_min=0.015):
     """Best pose and cost of the nested optimisation on the grid: (pose (3,), cost, n_feasible)."""
-    model = efd.fit(efd.clean_polygon(contour_xy), harmonics)
+    model = efd.fit(clean_polygon(contour_xy), harmonics)
     curve_t, curve = efd.sample(model, CURVE_SAMPLES)
     outline = MplPath(curve)
     grid = SearchGrid(xy_step=xy_step, yaw_step=yaw_step, d_max=d_max, d_min=d_min)

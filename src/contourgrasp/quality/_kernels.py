@@ -1,7 +1,7 @@
 """Compiled inner loop of :func:`contourgrasp.quality.epsilon_many` for the L1 metric (numba).
 
 The ball radius of a grasp's wrench hull is the least distance of the origin to a supporting
-plane through three of its wrenches (see :func:`contourgrasp.quality._ball_radius_batch`). Testing
+plane through three of its wrenches (see :func:`contourgrasp.quality.wrench_space._ball_radius_batch`). Testing
 every triple's plane against every wrench is what numpy does in one broadcast; a loop can skip a
 plane whose distance could not lower the least found so far, and stop testing a plane at the first
 wrench on each side. Neither changes the result: a skipped plane would only have given a larger

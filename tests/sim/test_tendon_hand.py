@@ -70,7 +70,7 @@ from pathlib import Path  # noqa: E402
 import mujoco  # noqa: E402
 
 from contourgrasp.hand import chain_tip  # noqa: E402
-from contourgrasp.sim.hand_model import HandDesign, derive_body  # noqa: E402
+from contourgrasp.sim.tendon_hand import HandDesign, derive_body  # noqa: E402
 
 FIXTURES = Path(__file__).parent / "fixtures"
 

@@ -1,9 +1,9 @@
 """A MuJoCo hand model as the simulated hand: mounted on the scene's floating base, closed by one synergy.
 
-The bench's own hand is built from a hand file (:mod:`contourgrasp.sim.hand_model`). A hand
+The bench's own hand is built from a hand file (:mod:`contourgrasp.sim.tendon_hand`). A hand
 model is simulated as itself instead: :func:`mount_model` derives its hand file
-(:func:`~contourgrasp.sim.model_hand.derive_hand`) and returns a :class:`MountedHand`, which the
-scene takes where it takes a :class:`~contourgrasp.sim.hand_model.HandModel`. The model's palm
+(:func:`~contourgrasp.handmodels.derive.derive_hand`) and returns a :class:`MountedHand`, which the
+scene takes where it takes a :class:`~contourgrasp.sim.tendon_hand.HandModel`. The model's palm
 body is attached (MjSpec) inside the scene's ``palm`` body -- the 3-D hand frame of the derived
 file, on the same x, y, z, yaw base and servos -- at the pose the derivation measured, so the
 planner's hand frame and the simulated one coincide. The closing control ``c`` in [0, 1] of a
@@ -21,9 +21,9 @@ from functools import cached_property
 
 import numpy as np
 
-from .hand_model import BASE_XML, HAND_BIT, TABLE_BIT, HandDesign, base_servos_xml
-from .model_hand import Derivation, derive_hand, model_spec
-from .scene import mujoco
+from ..sim.tendon_hand import BASE_XML, HAND_BIT, TABLE_BIT, HandDesign, base_servos_xml
+from .derive import Derivation, derive_hand, model_spec
+from ..sim.scene import mujoco
 
 #: Prefix of the mounted model's names in the scene.
 PREFIX = "hand/"
@@ -149,16 +149,16 @@ def mount_model(model, *, fingertips=None, actuators=None, palm=None, approach=N
     Parameters
     ----------
     model : str or Path
-        A bundled model's name (:data:`~contourgrasp.sim.model_hand.MODELS`) or an MJCF file.
+        A bundled model's name (:data:`~contourgrasp.handmodels.derive.MODELS`) or an MJCF file.
     fingertips, actuators, palm, approach
-        As :func:`~contourgrasp.sim.model_hand.derive_hand`.
+        As :func:`~contourgrasp.handmodels.derive.derive_hand`.
     design : HandDesign
         The base servos' gains.
 
     Raises
     ------
     HandFileError, HandError, SimulationError
-        As :func:`~contourgrasp.sim.model_hand.derive_hand`.
+        As :func:`~contourgrasp.handmodels.derive.derive_hand`.
     """
     derivation = derive_hand(model, fingertips=fingertips, actuators=actuators, palm=palm, approach=approach)
     return MountedHand(path=model_spec(model, fingertips=fingertips).path, derivation=derivation, design=design)

@@ -7,8 +7,8 @@ from contourgrasp import tolerances as tol
 from contourgrasp.errors import HandError, HandFileError
 from contourgrasp.hand import Ray, SampledChain, chain_joints, chain_tip
 from contourgrasp.io.hand_file import hand_to_toml, load_hand, parse_hand
-from contourgrasp.sim.hand_model import build_hand
-from contourgrasp.sim.model_hand import MODELS, derive_hand
+from contourgrasp.sim.tendon_hand import build_hand
+from contourgrasp.handmodels.derive import MODELS, derive_hand
 
 #: Two fingers sliding straight in the palm plane: known rays (see the file).
 TWO_SLIDERS = Path(__file__).parent / "fixtures" / "two-sliders.xml"
@@ -67,10 +67,10 @@ def test_own_simulated_hand_reproduces_the_preset_within_a_millimetre(tmp_path):
 
 def test_model_closing_measures_the_known_slides_along_their_rays(sliders):
     """Each slider's tip travels its ray from 0 to its full travel, never past it, and in time order."""
-    from contourgrasp.sim.model_hand import close_model, model_closing, model_spec
+    from contourgrasp.handmodels.derive import record_closing, finger_travel, model_spec
 
     spec = model_spec(sliders, fingertips=["left_tip", "right_tip"])
-    closing = model_closing(derive_hand(sliders, fingertips=["left_tip", "right_tip"]).hand, close_model(spec))
+    closing = finger_travel(derive_hand(sliders, fingertips=["left_tip", "right_tip"]).hand, record_closing(spec))
     np.testing.assert_allclose(closing.travel, [0.04, 0.03], atol=1e-6)
     np.testing.assert_allclose(closing.progress[:, 0], 0.0, atol=1e-6)
     np.testing.assert_allclose(closing.progress[:, -1], [0.04, 0.03], atol=1e-6)
@@ -90,11 +90,11 @@ def test_the_approach_axis_decides_the_palm_plane(sliders):
 def test_the_level_reading_brings_the_inspire_thumb_as_deep_as_its_fingers():
     from dataclasses import replace
 
-    from contourgrasp.sim.model_hand import LEVEL, close_model, model_spec
+    from contourgrasp.handmodels.derive import LEVEL, record_closing, model_spec
 
-    along = close_model(replace(model_spec("inspire"), approach=None)).tips[:, 0, 2]  # open tips' depths, m
+    along = record_closing(replace(model_spec("inspire"), approach=None)).tips[:, 0, 2]  # open tips' depths, m
     assert along[1:].mean() - along[0] > 0.08  # along the fingers, the thumb's tip hangs a hand's width higher
-    levelled = close_model(model_spec("inspire"))
+    levelled = record_closing(model_spec("inspire"))
     assert model_spec("inspire").approach == LEVEL  # the bundled reading; "fingers" gives the one along the fingers
     assert model_spec("inspire", approach="fingers").approach is None
     depths = levelled.tips[:, 0, 2]
@@ -112,7 +112,7 @@ def test_level_keeps_a_hand_whose_tips_are_level_and_needs_two_fingers(sliders):
     level = derive_hand(sliders, fingertips=fingers, approach="level").hand
     along = derive_hand(sliders, fingertips=fingers, approach="fingers").hand
     np.testing.assert_allclose(level.starts, along.starts, atol=1e-9)  # the sliders' tips are equally deep
-    from contourgrasp.sim.model_hand import _levelled
+    from contourgrasp.handmodels.derive import _levelled
 
     with pytest.raises(HandFileError, match="needs two fingertips at least, got 1"):
         _levelled(np.eye(3), np.zeros((1, 3)), "one.xml")
@@ -198,7 +198,7 @@ def test_our_simulated_hand_is_not_built_from_measured_chains():
 
 
 def test_the_fit_table_says_which_chains_are_measured():
-    from contourgrasp.sim.model_hand import fit_table
+    from contourgrasp.handmodels.derive import fit_table
 
     assert fit_table(derive_hand("jaco-three-finger"))[-1] == (
         "3-D chains and palm: yes (as measured: thumb, index, pinky, the palm tilted)")

@@ -51,19 +51,19 @@ given a :class:`~contourgrasp.hand.FingerChain`: knuckle at the first joint, lin
 joint to tip, its open and closed joint angles measured in the chain's plane, when it passes
 :func:`~contourgrasp.hand.check_chain`. Any other finger (an arc, more hinges, a chain out of its
 plane) is given its chain as measured, a :class:`~contourgrasp.hand.SampledChain`: its hinges'
-anchors and its tip along the recorded closing (:func:`~contourgrasp.sim.model_fit.sampled_chain`),
+anchors and its tip along the recorded closing (:func:`~contourgrasp.handmodels.fit.sampled_chain`),
 every link a capsule of the finger's radius (a bounding capsule of each link's geoms was tried and
 refused too much: docs/hand-models.md, "The bench on the models"). The palm
-(:func:`~contourgrasp.sim.model_fit.palm_plate`): one collision geom's box gives its tilted
+(:func:`~contourgrasp.handmodels.fit.palm_plate`): one collision geom's box gives its tilted
 underside face; several give their rectangle, as deep as their deepest corner. The hand keeps
 its chains and palm only when every finger has a chain; otherwise it is a 2-D hand, and
 :attr:`Derivation.notes` says why. Finger radius: half the smallest extent of the
 fingertip body's collision geoms.
 
 *Parts.* The palm, the fingertips, the actuators, the hinge chains and the geoms' boxes are found by
-name in :mod:`contourgrasp.sim.model_parts`, which refuses a name the model does not have.
+name in :mod:`contourgrasp.handmodels.lookup`, which refuses a name the model does not have.
 
-*Forces* (:func:`contourgrasp.sim.model_force.fingertip_forces`, not part of the hand file): how hard
+*Forces* (:func:`contourgrasp.handmodels.force.fingertip_forces`, not part of the hand file): how hard
 each fingertip pushes along its path during the same closing, read from the drives' joint forces.
 
 *Gains.* The model says nothing about the planner's gains: every finger gets ``alpha`` 25 and
@@ -87,10 +87,10 @@ from .. import tolerances as tol  # noqa: E402
 from .. import validation  # noqa: E402
 from ..errors import HandError, HandFileError, SimulationError  # noqa: E402
 from ..hand import SLICE_CONTOUR, Hand, Palm, SampledChain  # noqa: E402
-from . import model_parts as parts  # noqa: E402
-from .calibrate import Closing, derive_virtual_starts  # noqa: E402
-from .model_fit import FingerFit, fit_chain, fit_finger, palm_plate, sampled_chain, travelled  # noqa: E402
-from .scene import TIMESTEP, mujoco_warnings  # noqa: E402
+from . import lookup  # noqa: E402
+from ..sim.calibrate import FingerTravel, derive_virtual_starts  # noqa: E402
+from .fit import FingerFit, fit_chain, fit_finger, palm_plate, sampled_chain, travelled  # noqa: E402
+from ..sim.scene import TIMESTEP, mujoco_warnings  # noqa: E402
 
 #: Time the open hand settles before closing, s.
 SETTLE_TIME = 2.0
@@ -234,7 +234,7 @@ class Derivation:
     notes : tuple of str
         Why the hand has no 3-D chains, when it has none.
     mount : Mount
-        How the simulation mounts and closes the model (:mod:`contourgrasp.sim.model_mount`).
+        How the simulation mounts and closes the model (:mod:`contourgrasp.handmodels.mount`).
     """
 
     hand: Hand
@@ -285,7 +285,7 @@ class Mount:
 
 
 @dataclass(frozen=True, eq=False)
-class ClosedModel:
+class ClosingRecord:
     """A model closed in free air: per finger the tips in the hand frame over time, and its moving joints.
 
     Attributes
@@ -346,7 +346,7 @@ def derive_hand(model, *, fingertips=None, actuators=None, palm=None, approach=N
     spec = model_spec(model, fingertips=fingertips, actuators=actuators, palm=palm, approach=approach,
                       max_imbalance=max_imbalance, tips_brush_table=tips_brush_table,
                       grasp_height_fraction=grasp_height_fraction, slice_contour=slice_contour)
-    closed = close_model(spec, close_time=close_time, hold_time=hold_time)
+    closed = record_closing(spec, close_time=close_time, hold_time=hold_time)
     fingers, fits, ends = [], [], []
     for i, finger_name in enumerate(closed.names):
         path = closed.tips[i, :, :2]
@@ -368,14 +368,14 @@ def _min_touching(n: int) -> int:
     return n if n <= 3 else n - 1
 
 
-def close_model(spec: ModelSpec, *, close_time: float = 1.0, hold_time: float = 0.5) -> ClosedModel:
+def record_closing(spec: ModelSpec, *, close_time: float = 1.0, hold_time: float = 0.5) -> ClosingRecord:
     """Load, fix the palm, close the synergy in free air and record the fingertips (module docstring)."""
     source = spec.path
-    m = parts.load_model(source)
+    m = lookup.load_model(source)
     collides = (m.geom_contype != 0) | (m.geom_conaffinity != 0)
-    run, acts, held, lo, hi, (tips_palm, joint_records, d) = free_air_closing(m, spec, close_time, hold_time)
+    run, acts, held, lo, hi, (tips_palm, joint_records, d) = simulate_closing(m, spec, close_time, hold_time)
     palm, tips, chains = run.palm, run.tips, run.chains
-    subtree = parts.subtree(m, palm)
+    subtree = lookup.subtree(m, palm)
     moved = np.linalg.norm(tips_palm - tips_palm[:, :1], axis=2).max(axis=1)
     if (still := np.flatnonzero(moved < tol.FINGER_MOVED)).size:
         i = int(still[0])
@@ -388,7 +388,7 @@ def close_model(spec: ModelSpec, *, close_time: float = 1.0, hold_time: float = 
         axes = _levelled(axes, tips_palm[:, 0], source) if spec.approach == LEVEL else axes
     else:
         axes = _hand_axes(_axis(spec.approach, source)[None])
-    palm_geoms = parts.palm_geoms(m, d, palm, subtree, axes, collides)
+    palm_geoms = lookup.palm_geoms(m, d, palm, subtree, axes, collides)
     knuckles = [float(joint_records[i][0, 0] @ axes[2]) for i, c in enumerate(chains) if len(c)]
     depth = 0.0 if palm_geoms is None else min([float(palm_geoms[:, 2].max())] + knuckles)
     shift = np.array([0.0, 0.0, depth])
@@ -396,25 +396,25 @@ def close_model(spec: ModelSpec, *, close_time: float = 1.0, hold_time: float = 
     mount = Mount(palm=m.body(palm).name, rotation=tuple(map(tuple, axes.tolist())), position=tuple(-shift),
                   actuators=tuple(m.actuator(a).name for a in acts), open_controls=tuple(lo.tolist()),
                   closed_controls=tuple(hi.tolist()), held=tuple((m.actuator(a).name, v) for a, v in held),
-                  finger_bodies=parts.finger_bodies(m, palm, tips), tip_depth=float(tips_hand[:, :, 2].max()),
+                  finger_bodies=lookup.finger_bodies(m, palm, tips), tip_depth=float(tips_hand[:, :, 2].max()),
                   palm_depth=0.0 if palm_geoms is None else max(0.0, float(palm_geoms[:, 2].max()) - depth))
-    return ClosedModel(names=tuple(spec.names or spec.fingertips), times=m.opt.timestep * np.arange(tips_palm.shape[1]),
+    return ClosingRecord(names=tuple(spec.names or spec.fingertips), times=m.opt.timestep * np.arange(tips_palm.shape[1]),
                        tips=tips_hand, mount=mount,
                        joints=tuple(np.transpose(j, (1, 0, 2)) @ axes.T - shift for j in joint_records),
-                       radius=np.array([parts.tip_radius(m, t, collides) for t in tips]),
+                       radius=np.array([lookup.tip_radius(m, t, collides) for t in tips]),
                        palm=None if palm_geoms is None else palm_plate(palm_geoms - shift))
 
 
-def free_air_closing(m, spec: ModelSpec, close_time: float, hold_time: float):
+def simulate_closing(m, spec: ModelSpec, close_time: float, hold_time: float):
     """Set ``m`` up for a closing in free air (module docstring) and close it once: (run, actuators, held,
     open_controls, closed_controls, closing).
 
-    ``run`` (:class:`ClosingRun`) closes the hand again from fresh data when called; ``actuators`` are the
+    ``run`` (:class:`ClosingSimulation`) closes the hand again from fresh data when called; ``actuators`` are the
     synergy's, ``held`` the (actuator, control) pairs kept at their pre-shape; the controls are the
     synergy's ends (the low ends of the ranges open the hand unless the fingertips end farther apart
     than they began); ``closing`` is ``run``'s record of the closing from open to closed.
     """
-    run, acts, held = _free_air(m, spec, close_time, hold_time)
+    run, acts, held = _set_up_free_air(m, spec, close_time, hold_time)
     lo, hi = run.m.actuator_ctrlrange[acts, 0], run.m.actuator_ctrlrange[acts, 1]
     closing = run(acts, lo, hi, held, spec.path)
     if _spread(closing[0][:, -1]) > _spread(closing[0][:, 0]):  # the high ends open the hand: close toward the low
@@ -423,7 +423,7 @@ def free_air_closing(m, spec: ModelSpec, close_time: float, hold_time: float):
     return run, acts, held, lo, hi, closing
 
 
-def _free_air(m, spec: ModelSpec, close_time: float, hold_time: float) -> tuple[ClosingRun, np.ndarray, list]:
+def _set_up_free_air(m, spec: ModelSpec, close_time: float, hold_time: float) -> tuple[ClosingSimulation, np.ndarray, list]:
     """Set ``m`` up for a closing in free air and the run that closes it, with the synergy's actuators and
     the held ones."""
     source = spec.path
@@ -433,13 +433,13 @@ def _free_air(m, spec: ModelSpec, close_time: float, hold_time: float) -> tuple[
     m.opt.gravity[:] = 0.0
     m.opt.timestep, m.opt.integrator = TIMESTEP, mujoco.mjtIntegrator.mjINT_IMPLICITFAST  # the scene's
     m.geom_contype[:] = m.geom_conaffinity[:] = 0  # free air: nothing to touch, fingers pass each other (as in the scene)
-    palm = parts.palm_body(m, spec.palm, spec.fingertips, source)
-    subtree = parts.subtree(m, palm)
-    tips = [parts.fingertip(m, name, subtree, source) for name in spec.fingertips]
-    acts = parts.actuators(m, spec.actuators, subtree, source)
-    held = parts.held_controls(m, spec.hold, subtree, source)
+    palm = lookup.palm_body(m, spec.palm, spec.fingertips, source)
+    subtree = lookup.subtree(m, palm)
+    tips = [lookup.fingertip(m, name, subtree, source) for name in spec.fingertips]
+    acts = lookup.actuators(m, spec.actuators, subtree, source)
+    held = lookup.held_controls(m, spec.hold, subtree, source)
     steps = tuple(max(1, round(t / m.opt.timestep)) for t in (SETTLE_TIME, close_time, hold_time))
-    run = ClosingRun(m, palm, tips, [parts.moving_path(m, tip, palm) for tip in tips],
+    run = ClosingSimulation(m, palm, tips, [lookup.moving_path(m, tip, palm) for tip in tips],
                      frozen=[j for j in range(m.njnt) if m.jnt_bodyid[j] not in subtree], steps=steps)
     return run, acts, held
 
@@ -450,7 +450,7 @@ def _spread(points: np.ndarray) -> float:
 
 
 @dataclass(frozen=True, eq=False)
-class ClosingRun:
+class ClosingSimulation:
     """One closing of the model from fresh data: settle open, ramp the synergy, hold."""
 
     m: mujoco.MjModel
@@ -473,13 +473,13 @@ class ClosingRun:
             for k in range(settle + ramp + hold + 1):
                 u = min(1.0, max(0.0, (k - settle) / ramp))
                 d.ctrl[acts] = open_ctrl + u * (closed_ctrl - open_ctrl)
-                parts.freeze(m, d, self.frozen)
+                lookup.freeze(m, d, self.frozen)
                 mujoco.mj_step(m, d) if k else mujoco.mj_forward(m, d)
                 if probe is not None:
                     probe(k, d)
                 if k >= settle:
                     position, rotation = d.xpos[self.palm].copy(), d.xmat[self.palm].reshape(3, 3).copy()
-                    records.append([(parts.tip_point(d, t) - position) @ rotation for t in self.tips])
+                    records.append([(lookup.tip_point(d, t) - position) @ rotation for t in self.tips])
                     joint_records.append([(d.xanchor[c] - position) @ rotation for c in self.chains])
         if d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number > 0 or not np.isfinite(np.asarray(records)).all():
             raise SimulationError(f"{source}: the model is unstable while closing (NaN or huge accelerations)")
@@ -524,22 +524,22 @@ def _hand_axes(pointing: np.ndarray) -> np.ndarray:
     return np.stack([x, np.cross(z, x), z])
 
 
-def model_closing(hand: Hand, closed: ClosedModel) -> Closing:
+def finger_travel(hand: Hand, closed: ClosingRecord) -> FingerTravel:
     """The free-air closing of ``closed`` as distances along ``hand``'s fitted trajectories (its virtual starts' source)."""
     progress = np.array([travelled(f, closed.tips[i, :, :2]) for i, f in enumerate(hand.fingers)])
     # an arc runs from the path's first point, which may lie off the fitted ellipse by the fit error: its
     # nearest point to the closed tip can fall that much short of the travel, which is the finger closed
     reached = np.minimum([f.travel for f in hand.fingers], progress.max(axis=1))
-    return Closing(names=closed.names, travel=reached, times=closed.times, travelled=progress)
+    return FingerTravel(names=closed.names, travel=reached, times=closed.times, travelled=progress)
 
 
-def _with_virtual_starts(hand: Hand, closed: ClosedModel) -> Hand:
-    starts = derive_virtual_starts(model_closing(hand, closed))
+def _with_virtual_starts(hand: Hand, closed: ClosingRecord) -> Hand:
+    starts = derive_virtual_starts(finger_travel(hand, closed))
     fingers = tuple(replace(f, virtual_start=round(starts[f.name], 4) + 0.0) for f in hand.fingers)
     return replace(hand, fingers=fingers)
 
 
-def _with_chains(hand: Hand, closed: ClosedModel, ends: list[int]) -> tuple[Hand, tuple[str, ...]]:
+def _with_chains(hand: Hand, closed: ClosingRecord, ends: list[int]) -> tuple[Hand, tuple[str, ...]]:
     if closed.palm is None:
         return hand, ("the palm body has no collision geoms: no [palm], so no 3-D chains",)
     chains, notes = [], []

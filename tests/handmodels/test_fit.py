@@ -7,7 +7,7 @@ import pytest
 from contourgrasp import tolerances as tol
 from contourgrasp.errors import HandError
 from contourgrasp.hand import Arc
-from contourgrasp.sim.model_fit import BOX_CORNERS, fit_finger, palm_plate
+from contourgrasp.handmodels.fit import BOX_CORNERS, fit_finger, palm_plate
 
 
 def test_fit_finger_recovers_an_arc_and_refuses_a_zigzag():
@@ -23,7 +23,7 @@ def test_fit_finger_recovers_an_arc_and_refuses_a_zigzag():
 
 
 def box_corners(centre, half, turn=0.0):
-    """(8, 3) float: a box's corners in model_fit.BOX_CORNERS's order, turned by ``turn`` about the y axis."""
+    """(8, 3) float: a box's corners in fit.BOX_CORNERS's order, turned by ``turn`` about the y axis."""
     c, s = np.cos(turn), np.sin(turn)
     rotation = np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
     return np.asarray(centre) + (BOX_CORNERS * half) @ rotation.T

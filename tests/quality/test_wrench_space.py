@@ -16,10 +16,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.optimize import linprog, minimize
 
-from contourgrasp import InputError, efd
+from contourgrasp import InputError, contour
 from contourgrasp import tolerances as cg_tol
 from contourgrasp.errors import QualityError
-from contourgrasp import quality as q
+from contourgrasp.quality import wrench_space as q
 from conftest import disc, rotate
 
 A = 0.03  # half-width of the box, m
@@ -351,28 +351,28 @@ def test_input_error_is_a_value_error():
 @pytest.mark.parametrize("clockwise", [False, True])
 def test_contour_normals_of_a_circle_point_to_its_centre(clockwise):
     polygon = disc(0.04, centre=(0.1, -0.2))
-    model = efd.fit(polygon[::-1] if clockwise else polygon, harmonics=4)
+    model = contour.fit(polygon[::-1] if clockwise else polygon, harmonics=4)
     t = np.linspace(0, model.T, 37)
-    towards = np.array([0.1, -0.2]) - efd.evaluate(model, t)
+    towards = np.array([0.1, -0.2]) - contour.evaluate(model, t)
     towards /= np.linalg.norm(towards, axis=1, keepdims=True)
     np.testing.assert_allclose(q.contour_normals(model, t), towards, atol=1e-6)
 
 
 def test_contour_normals_keep_the_shape_of_t_and_are_unit():
-    model = efd.fit(disc(0.04) * [1.5, 1.0], harmonics=6)
+    model = contour.fit(disc(0.04) * [1.5, 1.0], harmonics=6)
     t = np.linspace(0, model.T, 12).reshape(3, 4)
     normals = q.contour_normals(model, t)
     assert normals.shape == (3, 4, 2) and q.contour_normals(model, 0.0).shape == (2,)
     np.testing.assert_allclose(np.linalg.norm(normals, axis=-1), 1.0)
     # A step along the normal moves into the ellipse (x / 0.06)^2 + (y / 0.04)^2 < 1.
-    inside = efd.evaluate(model, t.ravel()) + 1e-3 * normals.reshape(-1, 2)
+    inside = contour.evaluate(model, t.ravel()) + 1e-3 * normals.reshape(-1, 2)
     assert np.all(np.sum((inside / [0.06, 0.04]) ** 2, axis=1) < 1)
 
 
 def test_normals_of_a_fitted_disc_give_a_closing_three_finger_grasp():
-    model = efd.fit(disc(0.04), harmonics=4)
+    model = contour.fit(disc(0.04), harmonics=4)
     t = model.T * np.array([0.0, 1 / 3, 2 / 3])
-    p, n = efd.evaluate(model, t), q.contour_normals(model, t)
+    p, n = contour.evaluate(model, t), q.contour_normals(model, t)
     assert q.epsilon(p, n, mu=0.3, centre=model.locus) == pytest.approx(0.3, rel=1e-3)
 
 
