@@ -143,10 +143,10 @@ def sweep(draws: int = 5, sim: bool = False) -> str:
     return "\n".join(lines)
 
 
-def concave_runs(model: efd.EFD, samples: int = 2048) -> int:
+def concave_runs(model: contour.EFD, samples: int = 2048) -> int:
     """Number of separate concave stretches of the EFD curve."""
     t = np.linspace(0.0, model.T, samples, endpoint=False)
-    c = efd.concave(model, t)
+    c = contour.concave(model, t)
     if c.all():
         return 1
     return int(np.sum(c & ~np.roll(c, 1)))
