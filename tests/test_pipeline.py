@@ -271,7 +271,7 @@ def test_rgb_segmentation_of_the_bundled_frame_is_repaired_not_refused():
     ({"T_base_camera": np.eye(3)}, r"T_base_camera must be a \(4, 4\) array"),
     ({"T_base_camera": np.diag([2.0, 1.0, 1.0, 1.0])}, "T_base_camera: the rotation is not orthonormal"),
     ({"T_base_camera": "eye"}, "T_base_camera must be an array of real numbers"),
-    ({"xy_stepp": 0.05}, "synthesis options: unknown option 'xy_stepp'"),
+    ({"xy_stepp": 0.05}, "plan_grasp: unknown option 'xy_stepp'"),
 ])
 def test_bad_options_are_refused_by_name(options, message):
     frame = bundled()
@@ -354,20 +354,15 @@ from hypothesis import strategies as st  # noqa: E402
 def test_random_frames_and_options_plan_or_raise_input_error(data):
     import warnings
 
-    from contourgrasp.pipeline import plan_frame
-
     h, w = data.draw(st.integers(1, 40), label="h"), data.draw(st.integers(1, 40), label="w")
     depth, rgb = _fuzz_frame(data, h, w)
     intrinsics = _fuzz_intrinsics(data, h, w)
     options = {"xy_step": 0.03, "yaw_step": math.radians(10)} | _fuzz_options(data)
-    entry = data.draw(st.sampled_from(["plan_grasp", "plan_frame"]), label="entry")
+    planner = data.draw(st.sampled_from([None, "default"]), label="planner")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
-            if entry == "plan_grasp":
-                cg.plan_grasp(rgb, depth, intrinsics, "three-finger", **options)
-            else:
-                plan_frame(rgb, depth, intrinsics, cg.load_hand("three-finger"), **options)
+            cg.plan_grasp(rgb, depth, intrinsics, "three-finger", planner=planner, **options)
         except (cg.InputError, cg.NoFeasibleGrasp):
             pass
 
@@ -386,7 +381,7 @@ def standing_can_frame():
 def test_a_3d_plan_descends_clear_and_puts_the_palm_at_the_grasp_height(standing_can_frame):
     rgb, depth, K = standing_can_frame
     hand = cg.load_hand("five-finger-linear")
-    result = pipeline.plan_frame(rgb, depth, K, hand, descent=True, grasp_height="auto", yaw_step=0.1)
+    result = cg.plan_grasp(rgb, depth, K, hand, descent=True, grasp_height="auto", yaw_step=0.1)
     check = result.plan.descent
     assert check.feasible[0] and check.clearance.min() >= check.margin - 1e-9
     assert result.grasp_height == check.tip_height[0]
@@ -402,7 +397,7 @@ def test_a_3d_plan_descends_clear_and_puts_the_palm_at_the_grasp_height(standing
 
 def test_without_3d_geometry_the_plan_stays_2d_and_says_so(standing_can_frame):
     rgb, depth, K = standing_can_frame
-    result = pipeline.plan_frame(rgb, depth, K, cg.load_hand("five-finger-curved-thumb"), descent=True,
+    result = cg.plan_grasp(rgb, depth, K, cg.load_hand("five-finger-curved-thumb"), descent=True,
                                  small_objects=True, yaw_step=0.1)
     assert result.grasp_height is None and result.plan.descent is None
     assert any("no 3-D geometry" in note for note in result.plan.notes)
@@ -412,8 +407,8 @@ def test_the_slice_contour_is_the_cans_section_not_its_perspective_outline(stand
     """Seen from above and off-axis, the standing can's outline includes its side wall; its section is a 66 mm disc."""
     rgb, depth, K = standing_can_frame
     hand = cg.load_hand("five-finger-linear")
-    seen = pipeline.plan_frame(rgb, depth, K, hand, descent=True, xy_step=0.01, yaw_step=0.1)
-    sliced = pipeline.plan_frame(rgb, depth, K, hand, descent=True, grasp_height="auto", slice_contour=True,
+    seen = cg.plan_grasp(rgb, depth, K, hand, descent=True, xy_step=0.01, yaw_step=0.1)
+    sliced = cg.plan_grasp(rgb, depth, K, hand, descent=True, grasp_height="auto", slice_contour=True,
                                  small_objects=True, xy_step=0.01, yaw_step=0.1)
     width = lambda contour: float(np.ptp(contour, axis=0).max())  # noqa: E731
     assert width(sliced.plan.contour) == pytest.approx(0.066, abs=0.006)
@@ -430,8 +425,8 @@ def test_the_small_object_rule_plans_a_strawberry_with_fewer_fingers():
     scene = build_scene(ycb.load_object("ycb:012_strawberry"), seed=0, hand=hand)
     rgb, depth = render(scene, noise=True, seed=0)
     with pytest.raises(cg.NoFeasibleGrasp, match="4 fingers"):
-        pipeline.plan_frame(rgb, depth, scene.camera.intrinsics, hand, xy_step=0.01, yaw_step=0.1)
-    result = pipeline.plan_frame(rgb, depth, scene.camera.intrinsics, hand, small_objects=True, xy_step=0.01,
+        cg.plan_grasp(rgb, depth, scene.camera.intrinsics, hand, xy_step=0.01, yaw_step=0.1)
+    result = cg.plan_grasp(rgb, depth, scene.camera.intrinsics, hand, small_objects=True, xy_step=0.01,
                                  yaw_step=0.1)
     assert result.plan.hand.min_touching < hand.min_touching
     assert sum(not f.missed for f in result.plan.fingers) >= result.plan.hand.min_touching
@@ -451,7 +446,7 @@ def test_fingertip_balls_plan_and_lift_a_block_narrower_than_the_points_reach():
     block = ycb.load_object("ycb:070-b_colored_wood_blocks")
     scene = build_scene(block, seed=0, hand=hand)
     rgb, depth = render(scene, noise=True, seed=0)
-    result = pipeline.plan_frame(rgb, depth, scene.camera.intrinsics, hand, small_objects=True, descent=True,
+    result = cg.plan_grasp(rgb, depth, scene.camera.intrinsics, hand, small_objects=True, descent=True,
                                  grasp_height="auto", xy_step=0.01, yaw_step=0.1)
     assert result.plan.grown == min(f.radius for f in hand.fingers)  # grown only when the points reach nothing
     assert "as points" in result.plan.notes[-1]
@@ -483,10 +478,10 @@ def test_a_tall_box_with_no_balanced_squeeze_on_its_outline_seen_is_planned_on_i
     box = ycb.load_object("ycb:003_cracker_box")
     scene = build_scene(box, seed=4, hand=hand)
     rgb, depth = render(scene, noise=True, seed=4)
-    options = cg.load_planner("default").plan_options | cg.load_planner("default").synthesis_options
-    seen = pipeline.plan_frame(rgb, depth, scene.camera.intrinsics, hand, **(options | {"slice_contour": False}))
+    options = dict(cg.load_planner("default").settings)
+    seen = cg.plan_grasp(rgb, depth, scene.camera.intrinsics, hand, **(options | {"slice_contour": False}))
     assert not seen.plan.balanced and any("no pose balances" in n for n in seen.plan.notes)
-    sliced = pipeline.plan_frame(rgb, depth, scene.camera.intrinsics, hand, **options)
+    sliced = cg.plan_grasp(rgb, depth, scene.camera.intrinsics, hand, **options)
     assert sliced.plan.balanced and "cross-section" in sliced.plan.notes[-1]
     asked, _ = grasp_height(hand, sliced.height_map, "auto")  # the section is where the tips are asked to close
     section = cross_section(sliced.height_map, asked)
@@ -494,7 +489,7 @@ def test_a_tall_box_with_no_balanced_squeeze_on_its_outline_seen_is_planned_on_i
     assert np.ptp(sliced.plan.contour, axis=0).max() < np.ptp(seen.plan.contour, axis=0).max()
     assert run_trial(box, seed=4, planner=make_planner("default", hand), hand=hand).success
     assert options["slice_contour"] == "hand" and hand.slice_contour == "unbalanced"
-    never = pipeline.plan_frame(rgb, depth, scene.camera.intrinsics, replace(hand, slice_contour=False), **options)
+    never = cg.plan_grasp(rgb, depth, scene.camera.intrinsics, replace(hand, slice_contour=False), **options)
     np.testing.assert_array_equal(never.plan.contour, seen.plan.contour)
 
 
@@ -503,9 +498,9 @@ def test_a_plan_balanced_on_its_outline_seen_keeps_it(standing_can_frame):
     hand = cg.load_hand("five-finger-linear")
     options = {"descent": True, "grasp_height": "auto", "max_imbalance": "hand", "require_closure": True,
                "small_objects": True, "yaw_step": 0.1}
-    seen = pipeline.plan_frame(rgb, depth, K, hand, **options)
+    seen = cg.plan_grasp(rgb, depth, K, hand, **options)
     assert seen.plan.balanced
-    kept = pipeline.plan_frame(rgb, depth, K, hand, slice_contour="unbalanced", **options)
+    kept = cg.plan_grasp(rgb, depth, K, hand, slice_contour="unbalanced", **options)
     np.testing.assert_array_equal(kept.plan.contour, seen.plan.contour)
     np.testing.assert_array_equal(kept.plan.pose, seen.plan.pose)
 
@@ -519,11 +514,11 @@ def test_low_objects_plans_an_object_lower_than_the_threshold_as_a_pinch_and_a_t
     options = {"descent": True, "grasp_height": "auto", "small_objects": True, "low_objects": True, "yaw_step": 0.1}
     scene = build_scene(flat_tool(), seed=0, hand=hand)  # its grip stands 24 mm
     rgb, depth = render(scene, noise=True, seed=0)
-    low = pipeline.plan_frame(rgb, depth, scene.camera.intrinsics, hand, **options)
+    low = cg.plan_grasp(rgb, depth, scene.camera.intrinsics, hand, **options)
     assert low.height_map.max_height < cg.tolerances.LOW_OBJECT_HEIGHT
     assert "a low object" in low.plan.notes[-1] and low.plan.grown == min(f.radius for f in hand.fingers)
     assert low.plan.hand.min_touching == 2
-    tall = pipeline.plan_frame(*standing_can_frame, hand, **options)
+    tall = cg.plan_grasp(*standing_can_frame, hand, **options)
     assert not any("a low object" in note for note in tall.plan.notes) and tall.plan.grown == 0.0
 
 
@@ -531,11 +526,11 @@ def test_the_3d_plan_figure_shows_each_fingers_plane(standing_can_frame):
     from contourgrasp.visualize import image_plan_figure
 
     rgb, depth, K = standing_can_frame
-    result = pipeline.plan_frame(rgb, depth, K, cg.load_hand("five-finger-linear"), descent=True,
+    result = cg.plan_grasp(rgb, depth, K, cg.load_hand("five-finger-linear"), descent=True,
                                  grasp_height="auto", yaw_step=0.1)
     titles = [ax.get_title() for ax in image_plan_figure(result, rgb).axes]
     assert any("each finger's plane" in t and "least clearance" in t for t in titles)
-    flat = pipeline.plan_frame(rgb, depth, K, cg.load_hand("five-finger-linear"), yaw_step=0.1)
+    flat = cg.plan_grasp(rgb, depth, K, cg.load_hand("five-finger-linear"), yaw_step=0.1)
     assert not any("each finger's plane" in ax.get_title() for ax in image_plan_figure(flat, rgb).axes)
 
 
@@ -548,4 +543,4 @@ def test_the_3d_plan_figure_shows_each_fingers_plane(standing_can_frame):
 def test_bad_3d_options_are_refused_by_name_even_for_a_2d_hand(standing_can_frame, options, message):
     rgb, depth, K = standing_can_frame
     with pytest.raises(cg.errors.PlannerError, match=message):
-        pipeline.plan_frame(rgb, depth, K, cg.load_hand("five-finger-curved-thumb"), yaw_step=0.3, **options)
+        cg.plan_grasp(rgb, depth, K, cg.load_hand("five-finger-curved-thumb"), yaw_step=0.3, **options)

@@ -57,10 +57,11 @@ def synthesize(contour_xy, hand, *, planner=None, **options):
     """Plan a grasp on a metric contour: :func:`contourgrasp.synthesis.search` with names resolved.
 
     ``hand`` is a preset name, a TOML path or a :class:`Hand`; ``planner`` a
-    planner preset name (``"paper"``, ``"default"``), a planner TOML path or
-    None (the options' defaults, which are the thesis's). ``options`` are
-    keyword options of :func:`contourgrasp.synthesis.search` and override
-    the planner's.
+    planner preset name (``"paper"``, ``"default"``), a planner TOML path, a loaded planner, or
+    None (the thesis's settings). ``options`` are the search's options by name
+    (:class:`~contourgrasp.synthesis.SearchOptions`: ``harmonics``, ``xy_step``, ``friction``, ...),
+    which override the planner's, and :func:`~contourgrasp.synthesis.search`'s own keywords
+    (``descent``, ``low_object``, ``balance_required``, ``balanced_alternative``).
 
     Returns
     -------
@@ -87,24 +88,39 @@ def synthesize(contour_xy, hand, *, planner=None, **options):
     from .io.hand_file import load_hand
     from .io.planner_file import load_planner
 
-    validation.options("synthesize", options, synthesis.search, error=PlannerError)
-    settings = {} if planner is None else load_planner(planner).synthesis_options
-    return synthesis.search(contour_xy, load_hand(hand), **(settings | options))
+    calls = validation.options("synthesize", {k: v for k, v in options.items() if k in _SEARCH_CALL},
+                               synthesis.search, error=PlannerError)
+    base = synthesis.SearchOptions() if planner is None else load_planner(planner).options.search
+    chosen = validation.with_options(base, {k: v for k, v in options.items() if k not in _SEARCH_CALL},
+                                     what="synthesize", error=PlannerError)
+    return synthesis.search(contour_xy, load_hand(hand), chosen, **calls)
+
+
+#: :func:`contourgrasp.synthesis.search`'s own keywords, which :func:`synthesize` passes on.
+_SEARCH_CALL = ("descent", "low_object", "balance_required", "balanced_alternative")
+#: :func:`contourgrasp.pipeline.plan_frame`'s own keywords, which :func:`plan_grasp` passes on.
+_FRAME_CALL = ("mask", "target_px", "roi", "T_base_camera")
 
 
 def plan_grasp(rgb, depth, intrinsics, hand="five-finger-linear", *, planner=None, **options):
     """Plan a grasp on one RGB-D frame; ``hand`` and ``planner`` as in :func:`synthesize`.
 
-    Returns an :class:`contourgrasp.pipeline.ImageGraspPlan` (``.plan`` is the
-    :class:`GraspPlan`, ``.T_camera_hand`` the 6-DoF pose); see
-    :func:`contourgrasp.pipeline.plan_frame` for the options, which override the planner's.
+    ``options`` are :class:`~contourgrasp.pipeline.PlanOptions` by name (``segment``, ``depth_mode``,
+    ``xy_step``, ``descent``, ``standoff``, ...), which override the planner's, and
+    :func:`~contourgrasp.pipeline.plan_frame`'s own keywords (``mask``, ``target_px``, ``roi``,
+    ``T_base_camera``). Returns an :class:`contourgrasp.pipeline.ImageGraspPlan` (``.plan`` is the
+    :class:`GraspPlan`, ``.T_camera_hand`` the 6-DoF pose).
     """
+    from . import validation
     from .io.hand_file import load_hand
     from .io.planner_file import load_planner
-    from .pipeline import plan_frame
+    from .pipeline import PlanOptions, plan_frame
 
-    settings = {} if planner is None else load_planner(planner).plan_options
-    return plan_frame(rgb, depth, intrinsics, load_hand(hand), **(settings | options))
+    base = PlanOptions() if planner is None else load_planner(planner).options
+    chosen = validation.with_options(base, {k: v for k, v in options.items() if k not in _FRAME_CALL},
+                                     what="plan_grasp", error=PlannerError)
+    return plan_frame(rgb, depth, intrinsics, load_hand(hand), chosen,
+                      **{k: v for k, v in options.items() if k in _FRAME_CALL})
 
 
 __all__ = [

@@ -16,15 +16,20 @@ from pathlib import Path
 
 import numpy as np
 
-from . import __version__, synthesize
+from . import __version__
 from .contour import CURVATURE_MODES, clean_polygon, efd
 from .errors import DepthUnitWarning, InputError, NoFeasibleGrasp, OutputError
 from .io.contour_file import example_contour, example_names, read_contour
 from .io.hand_file import load_hand, preset_names
-from .io.planner_file import load_planner, planner_names, synthesis_options
+from .io.planner_file import load_planner, planner_names
 from .io.plan_file import atomic_outputs, plan_to_dict, write_json
+from .pipeline import PlanOptions
+from .synthesis import search
+from .validation import with_options
 
 EXIT_OK, EXIT_INPUT, EXIT_INFEASIBLE = 0, 2, 3
+#: The options' defaults, for the flags' help (a flag not given keeps the planner's value).
+DEFAULTS = PlanOptions()
 #: The palm axes hand-from-model and bench --hand-model accept as the approach, "level"
 #: (contourgrasp.handmodels.derive.LEVEL: the fingers' axis turned until the thumb's open tip is as deep as the others')
 #: and "fingers" (the axis the fingers point along, the default for a model file).
@@ -138,7 +143,7 @@ def _parser() -> argparse.ArgumentParser:
     plan.add_argument("--bag-index", type=_non_negative_int, default=0, help="which colour image of the bag (from 0)")
     plan.add_argument("--depth-scale", type=_positive_float, default=0.001,
                       help="meters per unit of integer depth images (default 0.001: millimetres)")
-    plan.add_argument("--segment", choices=("auto", "rgb", "depth"), default="auto")
+    plan.add_argument("--segment", choices=("auto", "rgb", "depth"), help=f"segmentation method (default {DEFAULTS.perception.segment})")
     plan.add_argument("--mask", help="binary image of the object: skips segmentation")
     target = plan.add_mutually_exclusive_group()
     target.add_argument("--target", type=_target_pixel, metavar="U,V",
@@ -161,8 +166,8 @@ def _parser() -> argparse.ArgumentParser:
     plan.add_argument("--colour-offset", type=_pixel_pair, metavar="DX,DY",
                       help="colour-depth misregistration in pixels, 0,0 for a pair registered to the pixel "
                            "(default: estimated from the object's edges)")
-    plan.add_argument("--approach-offset", type=_number, default=0.01, help="added to the nearest depth, m")
-    plan.add_argument("--standoff", type=_non_negative_float, default=0.10, help="pre-grasp distance, m")
+    plan.add_argument("--approach-offset", type=_number, help=f"added to the nearest depth, m (default {DEFAULTS.perception.approach_offset:g})")
+    plan.add_argument("--standoff", type=_non_negative_float, help=f"pre-grasp distance, m (default {DEFAULTS.standoff:g})")
     plan.add_argument("--extrinsics", help="T_base_camera (4x4): .npy, .txt, .json, .yaml or autolab .tf")
     _add_synthesis_options(plan)
 
@@ -238,7 +243,7 @@ def _add_synthesis_options(parser) -> None:
     parser.add_argument("--max-imbalance", type=_imbalance, metavar="SHARE|hand",
                         help="prefer poses whose equal finger pushes leave at most this net force, share of their "
                              "sum (0..1; 1: off), or 'hand': the hand file's own")
-    parser.add_argument("--top-k", type=_positive_int, default=10, help="ranked distinct poses to report")
+    parser.add_argument("--top-k", type=_positive_int, help=f"ranked distinct poses to report (default {DEFAULTS.search.top_k})")
     parser.add_argument("--refine", action=argparse.BooleanOptionalAction,
                         help="refine the best grid poses continuously (x, y, yaw) and report the gain")
     parser.add_argument("--out", help="write the plan JSON here (default: print it)")
@@ -320,8 +325,8 @@ def _add_hand_from_model_parser(sub) -> None:
     derive.add_argument("--out", required=True, help="the hand TOML to write")
 
 
-def _plan_options(args) -> dict:
-    """The planner's options of ``plan_frame``, overridden by the options given on the command line."""
+def _plan_options(args):
+    """The planner's :class:`~contourgrasp.pipeline.PlanOptions`, with the options given on the command line put in."""
     if args.d_max is not None and len(args.d_max) > 2:
         raise InputError(f"--d-max takes one or two values, got {len(args.d_max)}")
     given = {
@@ -338,12 +343,18 @@ def _plan_options(args) -> dict:
         "quality_gain": args.quality_gain,
         "centring_gain": args.centring_gain,
         "max_imbalance": args.max_imbalance,
-        "depth_mode": getattr(args, "depth_mode", None),
-        "footprint": getattr(args, "footprint", None),
         "top_k": args.top_k,
         "refine": args.refine,
+        "segment": getattr(args, "segment", None),
+        "depth_mode": getattr(args, "depth_mode", None),
+        "footprint": getattr(args, "footprint", None),
+        "fill_holes": False if getattr(args, "no_fill_holes", False) else None,
+        "colour_offset_px": getattr(args, "colour_offset", None),
+        "approach_offset": getattr(args, "approach_offset", None),
+        "standoff": getattr(args, "standoff", None),
     }
-    return load_planner(args.planner).plan_options | {k: v for k, v in given.items() if v is not None}
+    return with_options(load_planner(args.planner).options, {k: v for k, v in given.items() if v is not None},
+                        what="options", error=InputError)
 
 
 def _inputs(args) -> list:
@@ -380,7 +391,7 @@ def _hands(_args) -> int:
 
 
 def _synth(args) -> int:
-    plan = synthesize(_contour(args.contour), load_hand(args.hand), **synthesis_options(_plan_options(args)))
+    plan = search(_contour(args.contour), load_hand(args.hand), _plan_options(args).search)
 
     def figure():
         from .visualize import plan_figure
@@ -412,20 +423,12 @@ def _plan(args) -> int:
     frame = _bag_frame(args) if args.bag else _read_frame(args)
     if frame.depth is None:
         raise InputError("plan needs --depth and --intrinsics, or --bag")
-    options = {
-        "segment": args.segment,
-        "mask": frame.mask,
-        "fill_holes": not args.no_fill_holes,
-        "colour_offset_px": args.colour_offset,
-        "approach_offset": args.approach_offset,
-        "standoff": args.standoff,
-        "T_base_camera": None if args.extrinsics is None else read_extrinsics(args.extrinsics),
-        **_plan_options(args),
-    }
+    options = _plan_options(args)
+    extrinsics = None if args.extrinsics is None else read_extrinsics(args.extrinsics)
     if args.all:
-        return _plan_all(args, frame, options)
-    result = plan_frame(frame.rgb, frame.depth, frame.intrinsics, load_hand(args.hand), target_px=args.target,
-                        roi=args.roi, **options)
+        return _plan_all(args, frame, options, extrinsics)
+    result = plan_frame(frame.rgb, frame.depth, frame.intrinsics, load_hand(args.hand), options, mask=frame.mask,
+                        target_px=args.target, roi=args.roi, T_base_camera=extrinsics)
 
     def figure():
         from .visualize import image_plan_figure
@@ -436,16 +439,16 @@ def _plan(args) -> int:
     return EXIT_OK
 
 
-def _plan_all(args, frame, options) -> int:
+def _plan_all(args, frame, options, extrinsics) -> int:
     """``plan --all``: a plan per wholly visible candidate, written all or none (naming in ``--help``)."""
     from .io.plan_file import image_plan_to_dict
     from .perception import choose_target
     from .pipeline import find_objects, plan_frame
     from .tolerances import MAX_ALL_OBJECTS
 
-    if frame.mask is not None or args.segment == "rgb":
+    if frame.mask is not None or options.perception.segment == "rgb":
         raise InputError("--all plans every depth candidate: not with --mask or --segment rgb")
-    candidates = find_objects(frame.depth, frame.intrinsics, fill_holes=options["fill_holes"]).candidates
+    candidates = find_objects(frame.depth, frame.intrinsics, fill_holes=options.perception.fill_holes).candidates
     choose_target(candidates)  # refuses, in one line, an empty scene or one whose every region touches the border
     inner = [c for c in candidates if c.in_view]
     if len(inner) > MAX_ALL_OBJECTS:
@@ -455,8 +458,8 @@ def _plan_all(args, frame, options) -> int:
         rows, cols = np.nonzero(c.mask)  # plan_frame finds the same candidates: any of its pixels names it
         pixel = (int(cols[len(cols) // 2]), int(rows[len(rows) // 2]))
         try:
-            planned.append((c.label, plan_frame(frame.rgb, frame.depth, frame.intrinsics, hand, target_px=pixel,
-                                                **options)))
+            planned.append((c.label, plan_frame(frame.rgb, frame.depth, frame.intrinsics, hand, options,
+                                                target_px=pixel, T_base_camera=extrinsics)))
         except NoFeasibleGrasp as err:
             failed.append((c.label, EXIT_INFEASIBLE, f"no feasible grasp: {err.reason}"))
         except InputError as err:

@@ -30,16 +30,55 @@ from scipy.spatial.transform import Rotation
 from . import perception, validation
 from . import tolerances as tol
 from .errors import HandError, NoFeasibleGrasp, PerceptionError, PlannerError, SegmentationError
-from .hand import SLICE_CONTOUR as HAND_SLICE_CONTOUR
 from .hand import Hand
 from .perception import HeightMap, Intrinsics, MetricContour, Plane, Segmentation
 from .perception.camera import check_intrinsics
+from .perception.options import PerceptionOptions
 from .synthesis import Descent, GraspPlan, search
-from .synthesis.grasp_height import check_rule as check_grasp_height
 from .synthesis.grasp_height import grasp_height as choose_grasp_height
-from .tolerances import APPROACH_OFFSET, HOMOGENEOUS_ROW, MAX_APPROACH_OFFSET, MAX_STANDOFF, ROTATION_TOLERANCE
+from .synthesis.options import SceneOptions, SearchOptions
+from .tolerances import HOMOGENEOUS_ROW, MAX_STANDOFF, ROTATION_TOLERANCE
 
-SEGMENT_CHOICES = perception.SEGMENT_METHODS
+
+@dataclass(frozen=True, kw_only=True)
+class PlanOptions:
+    """Every option of :func:`plan_frame`, by stage: what a planner file, the command line and the ROS node's
+    parameters set (:func:`contourgrasp.validation.with_options` puts flat-named values in).
+
+    Attributes
+    ----------
+    perception : PerceptionOptions
+    search : SearchOptions
+    scene : SceneOptions
+        Planning with the hand's 3-D bodies in the scene.
+    standoff : float
+        Distance of the pre-grasp pose back along the approach axis, m, in [0, ``MAX_STANDOFF``] (2 m).
+
+    Raises
+    ------
+    InputError
+        Naming the option of the wrong type or value (PerceptionError for ``standoff``).
+
+    Examples
+    --------
+    >>> from contourgrasp.validation import with_options
+    >>> options = with_options(PlanOptions(), {"yaw_step": 0.1, "descent": True}, what="example")
+    >>> options.search.grid.yaw_step, options.scene.descent, options.standoff
+    (0.1, True, 0.1)
+    """
+
+    perception: PerceptionOptions = PerceptionOptions()
+    search: SearchOptions = SearchOptions()
+    scene: SceneOptions = SceneOptions()
+    standoff: float = 0.10
+
+    def __post_init__(self):
+        for name, kind in (("perception", PerceptionOptions), ("search", SearchOptions), ("scene", SceneOptions)):
+            if not isinstance(getattr(self, name), kind):
+                raise PlannerError(f"{name} must be a {kind.__name__}, got {type(getattr(self, name)).__name__}")
+        standoff = validation.non_negative("standoff", self.standoff, error=PerceptionError)
+        object.__setattr__(self, "standoff", validation.at_most("standoff", standoff, MAX_STANDOFF, " m",
+                                                                error=PerceptionError))
 
 
 @dataclass(frozen=True, eq=False)
@@ -107,30 +146,17 @@ def plan_frame(
     depth,
     intrinsics: Intrinsics,
     hand: Hand,
+    options: PlanOptions = PlanOptions(),
     *,
-    segment: str = "auto",
     mask=None,
-    depth_mode: str = "max",
-    footprint: bool | None = None,
-    fill_holes: bool = True,
-    colour_offset_px=None,
-    approach_offset: float = APPROACH_OFFSET,
-    standoff: float = 0.10,
-    T_base_camera=None,
     target_px=None,
     roi=None,
-    descent: bool = False,
-    grasp_height: str | float | None = None,
-    slice_contour: bool | str = False,
-    closing_sweep: bool = False,
-    closing_obstacles: bool = False,
-    low_objects: bool = False,
-    **synthesis_options,
+    T_base_camera=None,
 ) -> ImageGraspPlan:
     """Plan a grasp on one RGB-D frame with a :class:`~contourgrasp.hand.Hand`.
 
-    :func:`contourgrasp.plan_grasp` is this with a hand preset name or file and
-    a planner's settings.
+    :func:`contourgrasp.plan_grasp` is this with a hand preset name or file, a planner's settings and
+    flat-named options.
 
     Parameters
     ----------
@@ -140,32 +166,10 @@ def plan_frame(
         Depth in meters (0 or NaN where missing).
     intrinsics : Intrinsics
     hand : Hand
-    segment : {"auto", "rgb", "depth"}
-        Segmentation method (:func:`contourgrasp.perception.segment`); ignored with ``mask``.
+    options : PlanOptions
+        Perception, search and 3-D options (:class:`PlanOptions`; the defaults are the thesis's).
     mask : (H, W) bool, optional
         The user's own object mask; skips segmentation.
-    depth_mode : {"max", "plane"}
-        Height of the contour's plane (:func:`contourgrasp.perception.contour_to_metric`). With ``"max"``
-        depth segmentation returns the object's footprint when the camera is tilted, planned on the table
-        itself; with ``"plane"`` always the pixels that see the object, planned at the object's top.
-    footprint : bool, optional
-        With ``depth_mode="max"``: plan the object's footprint on the table
-        (:func:`contourgrasp.perception.object_footprint`) even from a top-down camera (True), or
-        never (False); by default only when the camera is tilted more than 2 deg.
-    fill_holes : bool
-        Fill small depth holes (nearest valid reading) before use.
-    colour_offset_px : (int, int), optional
-        The colour-depth misregistration (dx, dy) if known, ``(0, 0)`` for a pair registered to the
-        pixel; by default ``"auto"`` segmentation estimates it
-        (:func:`contourgrasp.perception.colour_offset`).
-    approach_offset : float
-        Added to the nearest depth inside the contour, m; at most ``MAX_APPROACH_OFFSET`` (0.5 m)
-        either way (:mod:`contourgrasp.tolerances`).
-    standoff : float
-        Distance of the pre-grasp pose back along the approach axis, m, in [0, ``MAX_STANDOFF``] (2 m).
-    T_base_camera : (4, 4) float, optional
-        Camera pose in the robot's base frame, a rigid transform (checked as
-        :func:`contourgrasp.io.camera_file.read_extrinsics` checks a file's).
     target_px : (int, int), optional
         Plan on the object under this pixel (u, v) of the depth image.
     roi : (int, int, int, int), optional
@@ -176,49 +180,30 @@ def plan_frame(
         image centre (with one object in view: the largest wholly visible region, as always);
         regions touching the image border are listed in ``candidates`` but never chosen.
         Both need depth segmentation (not ``mask`` or ``segment="rgb"``).
-    descent : bool
-        Plan with the hand's 3-D bodies: a pose is feasible only if the open hand descends to the
-        grasp height without any finger's body or the palm passing below the scene's height map
-        (:class:`~contourgrasp.synthesis.Descent`). Needs a 3-D hand and a table plane; without
-        them the plan is 2-D and says so in its notes.
-    grasp_height : {"clearance", "auto"} or float, optional
-        The height above the table of the open hand's lowest fingertip at the grasp
-        (:func:`~contourgrasp.synthesis.grasp_height.grasp_height`); with ``descent`` and None,
-        ``"clearance"``. Planned, it is the plan's ``grasp_height`` and ``T_camera_hand`` is the
-        hand at that height; None without ``descent``: ``T_camera_hand`` is at the approach
-        depth and the executor chooses how deep to go, as in the thesis.
-    slice_contour : bool or "unbalanced" or "hand"
-        With a planned grasp height: plan on the object's cross-section at that height
-        (:func:`contourgrasp.perception.cross_section`) rather than its outline as seen, where the
-        height map has one. ``"unbalanced"``: plan on the outline seen, and on the cross-section only
-        when no pose balances the squeeze on the outline seen but one does on the section (the plan's
-        notes say so, :data:`NOTE_SECTION`). Our reading: a tall object seen from above off the
-        camera's axis shows its side wall, so its outline seen is wider than the object at any height
-        (a standing cracker box's about twice its top), and fingers planned on the far side of it close
-        on air; where the outline seen still balances, it is kept (planning every object on its section
-        lost on the training objects, ``benchmarks/hand3d_sweep.md``). ``"hand"``: the hand's own
-        (:attr:`Hand.slice_contour`), as ``default`` asks: a hand that wraps an object with curling
-        links meets it where it is widest, the outline seen.
-    closing_sweep : bool
-        With ``descent``: also refuse a pose where a touching finger's chain would meet the scene
-        before its tip reaches its grasp point (:mod:`contourgrasp.synthesis.sweep`).
-    closing_obstacles : bool
-        With ``descent``: also refuse a pose where a finger, closing until it meets the target (or to
-        its end, if it misses), would run into a neighbouring object or a bin's wall -- the height
-        map's obstacle cells (:func:`contourgrasp.synthesis.sweep.closing_hits`).
-    low_objects : bool
-        Plan an object lower than ``tolerances.LOW_OBJECT_HEIGHT`` (its height map's ``max_height``) first as a
-        pinch of the thumb against one finger with the fingertips as balls (:func:`~contourgrasp.synthesis.search`'s
-        ``low_object``); needs a table (the height map).
-    **synthesis_options
-        Keyword options of :func:`contourgrasp.synthesis.search`.
+    T_base_camera : (4, 4) float, optional
+        Camera pose in the robot's base frame, a rigid transform (checked as
+        :func:`contourgrasp.io.camera_file.read_extrinsics` checks a file's).
+
+    Notes
+    -----
+    The 3-D options (:class:`~contourgrasp.synthesis.options.SceneOptions`) need a 3-D hand and a table
+    plane; without them the plan is 2-D and says so in its notes. ``slice_contour`` plans on the object's
+    cross-section at the grasp height rather than its outline as seen, where the height map has one;
+    ``"unbalanced"`` plans on the outline seen, and on the cross-section only when no pose balances the
+    squeeze on the outline seen but one does on the section (the plan's notes say so,
+    :data:`NOTE_SECTION`). Our reading: a tall object seen from above off the camera's axis shows its side
+    wall, so its outline seen is wider than the object at any height (a standing cracker box's about twice
+    its top), and fingers planned on the far side of it close on air; where the outline seen still
+    balances, it is kept (planning every object on its section lost on the training objects,
+    docs/studies.md). ``"hand"``: the hand's own (:attr:`Hand.slice_contour`), as ``default`` asks: a hand
+    that wraps an object with curling links meets it where it is widest, the outline seen.
 
     Raises
     ------
     PerceptionError
-        Bad images, intrinsics, extrinsics or options; no object found (SegmentationError).
+        Bad images, intrinsics or extrinsics; no object found (SegmentationError).
     PlannerError
-        An unknown or bad planning option.
+        ``options`` is not a :class:`PlanOptions`.
     HandError
         ``hand`` is not a :class:`~contourgrasp.hand.Hand`.
     NoFeasibleGrasp
@@ -226,75 +211,67 @@ def plan_frame(
     """
     if not isinstance(hand, Hand):
         raise HandError(f"hand must be a contourgrasp.Hand, got {type(hand).__name__}")
-    standoff = validation.non_negative("standoff", standoff, error=PerceptionError)
-    validation.at_most("standoff", standoff, MAX_STANDOFF, " m", error=PerceptionError)
-    validation.options("synthesis options", synthesis_options, search, error=PlannerError)
+    if not isinstance(options, PlanOptions):
+        raise PlannerError(f"options must be a contourgrasp.pipeline.PlanOptions, got {type(options).__name__}")
     if T_base_camera is not None:
         T_base_camera = validation.rigid_transform("T_base_camera", T_base_camera, error=PerceptionError,
                                                    rotation_tolerance=ROTATION_TOLERANCE,
                                                    row_tolerance=HOMOGENEOUS_ROW)
+    scene_options, search_options = options.scene, options.search
     with perception.one_frame():
         seg, metric, filled, d, table, scene = _perceive(
-            rgb, depth, intrinsics, segment=segment, mask=mask, depth_mode=depth_mode, footprint=footprint,
-            fill_holes=fill_holes, colour_offset_px=colour_offset_px, approach_offset=approach_offset,
-            target_px=target_px, roi=roi, max_width=perception.hand_opening(hand))
+            rgb, depth, intrinsics, options.perception, mask=mask, target_px=target_px, roi=roi,
+            max_width=perception.hand_opening(hand))
         heights = scene_heights(d, intrinsics, seg, metric, plane=table)
-    asked = _grasp_height(hand, heights, descent, grasp_height)
-    sweep = validation.flag("closing_sweep", closing_sweep, error=PlannerError)
-    closing = validation.flag("closing_obstacles", closing_obstacles, error=PlannerError)
-    spec = Descent(heights, *asked, sweep=sweep, closing=closing) if descent and asked is not None else None
-    if validation.flag("low_objects", low_objects, error=PlannerError) and heights is not None:
-        synthesis_options = {**synthesis_options, "low_object": bool(heights.max_height < tol.LOW_OBJECT_HEIGHT)}
-    slicing = validation.choice("slice_contour", slice_contour, SLICE_CONTOUR, error=PlannerError)
-    slicing = hand.slice_contour if slicing == "hand" else slicing
+    asked = _grasp_height(hand, heights, scene_options)
+    spec = (Descent(heights, *asked, sweep=scene_options.closing_sweep, closing=scene_options.closing_obstacles)
+            if scene_options.descent and asked is not None else None)
+    low = scene_options.low_objects and heights is not None and bool(heights.max_height < tol.LOW_OBJECT_HEIGHT)
+    slicing = hand.slice_contour if scene_options.slice_contour == "hand" else scene_options.slice_contour
     section = perception.cross_section(heights, asked[0]) if slicing is True and asked is not None else None
     on_section = None
     if slicing == "unbalanced" and asked is not None:
-        on_section = partial(_balanced_on_section, heights, hand, spec, asked[0], synthesis_options)
-    plan = search(metric.contour_xy if section is None else section, hand, descent=spec,
-                  balanced_alternative=on_section, **synthesis_options)
+        on_section = partial(_balanced_on_section, heights, hand, spec, asked[0], search_options, low)
+    plan = search(metric.contour_xy if section is None else section, hand, search_options, descent=spec,
+                  balanced_alternative=on_section, low_object=low)
     tip_height = None if asked is None else asked[0] if plan.descent is None else float(plan.descent.tip_height[0])
     depth_at = (metric.approach_depth if tip_height is None
-                else _palm_depth(metric, heights, hand, plan.pose, tip_height))
+                else palm_depth(metric, heights, hand, plan.pose, tip_height))
     T_camera_hand = hand_pose(metric, plan.pose, depth_at)
     T_camera_pregrasp = T_camera_hand.copy()
-    T_camera_pregrasp[:3, 3] -= standoff * T_camera_hand[:3, 2]
+    T_camera_pregrasp[:3, 3] -= options.standoff * T_camera_hand[:3, 2]
     T_base_hand = None if T_base_camera is None else T_base_camera @ T_camera_hand
     return ImageGraspPlan(plan, seg, metric, intrinsics, T_camera_hand, T_camera_pregrasp, T_base_hand, filled,
                           heights, *scene, grasp_height=tip_height)
 
 
-#: The values of :func:`plan_frame`'s ``slice_contour``: a hand's, or the hand's own.
-SLICE_CONTOUR = (*HAND_SLICE_CONTOUR, "hand")
 #: The note of a plan made on the cross-section because no pose balanced the squeeze on the outline seen.
 NOTE_SECTION = ("no pose balances the squeeze on the outline seen: planned on the object's cross-section "
                 "{height:.0f} mm above the table, the height where the fingertips close")
 
 
-def _balanced_on_section(heights: HeightMap, hand: Hand, descent, height: float, options) -> GraspPlan:
+def _balanced_on_section(heights: HeightMap, hand: Hand, descent, height: float, options: SearchOptions,
+                         low_object: bool) -> GraspPlan:
     """The plan on the object's cross-section at ``height`` with a balanced squeeze (the search requires
     it): the outline seen's ``balanced_alternative``. Raises NoFeasibleGrasp without one, or without a section."""
     section = perception.cross_section(heights, height)
     if section is None:
         raise NoFeasibleGrasp("the height map has no cross-section of the object")
-    sliced = search(section, hand, descent=descent, balance_required=True, **options)
+    sliced = search(section, hand, options, descent=descent, balance_required=True, low_object=low_object)
     return replace(sliced, search_notes=sliced.search_notes + (NOTE_SECTION.format(height=1000 * height),))
 
 
-def _grasp_height(hand: Hand, heights: HeightMap | None, descent, grasp_height) -> tuple[float, float] | None:
+def _grasp_height(hand: Hand, heights: HeightMap | None, options: SceneOptions) -> tuple[float, float] | None:
     """The grasp height asked for and the highest accepted, for :func:`plan_frame`'s options; None: not
-    planned (a 2-D hand, no table). A bad ``grasp_height`` is refused whether or not it could be used."""
-    descent = validation.flag("descent", descent, error=PlannerError)
-    if grasp_height is not None:
-        check_grasp_height(grasp_height)
-    if grasp_height is None and not descent:
+    planned (a 2-D hand, no table)."""
+    if options.grasp_height is None and not options.descent:
         return None
     if not hand.is_3d or heights is None:
         return None
-    return choose_grasp_height(hand, heights, "clearance" if grasp_height is None else grasp_height)
+    return choose_grasp_height(hand, heights, "clearance" if options.grasp_height is None else options.grasp_height)
 
 
-def _palm_depth(metric: MetricContour, heights: HeightMap, hand: Hand, pose, tip_height: float) -> float:
+def palm_depth(metric: MetricContour, heights: HeightMap, hand: Hand, pose, tip_height: float) -> float:
     """Depth along the approach axis of the palm's underside at ``pose`` when the open tips are ``tip_height`` up."""
     x, y = pose[:2]
     n, offset = heights.table_normal, heights.table_offset
@@ -323,33 +300,18 @@ def find_objects(depth, intrinsics: Intrinsics, *, fill_holes: bool = True) -> p
         return perception.find_support(d, intrinsics)
 
 
-def perceive(
-    rgb,
-    depth,
-    intrinsics: Intrinsics,
-    *,
-    segment: str = "auto",
-    mask=None,
-    depth_mode: str = "max",
-    footprint: bool | None = None,
-    fill_holes: bool = True,
-    colour_offset_px=None,
-    approach_offset: float = APPROACH_OFFSET,
-    target_px=None,
-) -> tuple[Segmentation, MetricContour, int]:
+def perceive(rgb, depth, intrinsics: Intrinsics, options: PerceptionOptions = PerceptionOptions(), *, mask=None,
+             target_px=None) -> tuple[Segmentation, MetricContour, int]:
     """The perception half of :func:`plan_frame`: (segmentation, metric contour, filled depth pixels).
 
     Checks the depth, fills small holes, segments (or takes ``mask``) and puts
-    the contour in meters; the options are :func:`plan_frame`'s.
+    the contour in meters; the arguments are :func:`plan_frame`'s.
     """
     with perception.one_frame():
-        return _perceive(rgb, depth, intrinsics, segment=segment, mask=mask, depth_mode=depth_mode,
-                         footprint=footprint, fill_holes=fill_holes, colour_offset_px=colour_offset_px,
-                         approach_offset=approach_offset, target_px=target_px)[:3]
+        return _perceive(rgb, depth, intrinsics, options, mask=mask, target_px=target_px)[:3]
 
 
-def _perceive(rgb, depth, intrinsics, *, segment, mask, depth_mode, footprint, fill_holes, colour_offset_px,
-              approach_offset, target_px=None, roi=None, max_width=None):
+def _perceive(rgb, depth, intrinsics, options: PerceptionOptions, *, mask, target_px=None, roi=None, max_width=None):
     """:func:`perceive`, the depth image it worked on (holes filled), the support plane (None if there is
     none: found once here, :func:`contourgrasp.perception.find_support`, and shared by segmentation, the
     metric contour and the height map), and (candidates, target, reason, support).
@@ -358,7 +320,11 @@ def _perceive(rgb, depth, intrinsics, *, segment, mask, depth_mode, footprint, f
     :func:`contourgrasp.perception.choose_target` (``max_width``: the hand's opening); when that is
     the largest wholly visible candidate, segmentation picks it itself (the same region, and its
     warnings), else it is handed to segmentation as the target."""
-    _check_options(intrinsics, segment, depth_mode, footprint, fill_holes, colour_offset_px, approach_offset)
+    check_intrinsics(intrinsics)
+    if not isinstance(options, PerceptionOptions):
+        raise PerceptionError(f"options must be a contourgrasp.perception.PerceptionOptions, "
+                              f"got {type(options).__name__}")
+    segment, depth_mode, fill_holes = options.segment, options.depth_mode, options.fill_holes
     chosen = target_px is not None or roi is not None
     if target_px is not None and roi is not None:
         raise PerceptionError("give target_px or roi, not both")
@@ -395,22 +361,22 @@ def _perceive(rgb, depth, intrinsics, *, segment, mask, depth_mode, footprint, f
     if mask is not None:
         seg = perception.segment_from_mask(mask)
     else:
-        options = {"footprint": False if depth_mode == "plane" else footprint}
+        depth_options = {"footprint": False if depth_mode == "plane" else options.footprint}
         if fill_holes:
-            options["fill_holes"] = False  # d is filled already: a second pass finds the same larger holes only
+            depth_options["fill_holes"] = False  # d is filled already: a second pass finds the same larger holes only
         if plane is not None and segment != "rgb":
-            options["plane"] = plane  # the same fit segmentation would make
+            depth_options["plane"] = plane  # the same fit segmentation would make
         if target is not None and (chosen or target is not next(c for c in candidates if c.in_view)):
-            options["target"] = target.mask  # else segmentation's own pick, the largest wholly visible region
+            depth_options["target"] = target.mask  # else segmentation's own pick, the largest wholly visible region
         if target_px is not None:
-            options["target_px"] = target_px  # which of the target's footprints, where touching neighbours share it
-        seg = perception.segment(rgb, d, intrinsics, method=segment, colour_offset_px=colour_offset_px,
-                                 depth_options=options)
+            depth_options["target_px"] = target_px  # which of the target's footprints, where neighbours share it
+        seg = perception.segment(rgb, d, intrinsics, method=segment, colour_offset_px=options.colour_offset_px,
+                                 depth_options=depth_options)
     if mask is not None or seg.method == "rgb":
         target, reason = _found_target(candidates, seg, mask is not None)
     metric = perception.contour_to_metric(
         seg.contour_px, d, intrinsics, depth_mode=depth_mode, plane=plane if seg.plane is None else seg.plane,
-        on_table=seg.on_table, offset=approach_offset,
+        on_table=seg.on_table, offset=options.approach_offset,
     )
     return seg, metric, filled, d, plane, (candidates, target, reason, support)
 
@@ -455,24 +421,6 @@ def scene_heights(depth, intrinsics: Intrinsics, segmentation: Segmentation, met
         except SegmentationError:
             return None
     return perception.height_map(depth, intrinsics, plane, metric, segmentation.mask)
-
-
-def _check_options(intrinsics, segment, depth_mode, footprint, fill_holes, colour_offset_px, approach_offset):
-    """Refuse, by name, a perception option of :func:`perceive` of the wrong type or value."""
-    check_intrinsics(intrinsics)
-    validation.choice("segment", segment, SEGMENT_CHOICES, error=PerceptionError)
-    validation.choice("depth_mode", depth_mode, perception.DEPTH_MODES, error=PerceptionError)
-    if footprint is not None and not isinstance(footprint, (bool, np.bool_)):
-        raise PerceptionError(f"footprint must be True, False or None, got {footprint!r}")
-    if footprint and depth_mode == "plane":
-        raise PerceptionError("footprint=True needs depth_mode 'max': a footprint lies on the table, not at the object's top")
-    validation.flag("fill_holes", fill_holes, error=PerceptionError)
-    if colour_offset_px is not None:
-        validation.pixel_offset("colour_offset_px", colour_offset_px, error=PerceptionError)
-    offset = validation.finite("approach_offset", approach_offset, error=PerceptionError)
-    if abs(offset) > MAX_APPROACH_OFFSET:
-        raise PerceptionError(f"approach_offset must be within +-{MAX_APPROACH_OFFSET:g} m of the object's top, "
-                              f"got {offset:g} m")
 
 
 def hand_pose(metric: MetricContour, pose, depth: float) -> np.ndarray:

@@ -19,6 +19,7 @@ contourgrasp.errors.InputError: xy_step must be a finite number, got '0.05'
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from inspect import Parameter, signature
 
@@ -148,6 +149,52 @@ def options(name: str, value, function, *, error: type[InputError] = InputError)
     if unknown:
         raise error(f"{name}: unknown option {unknown[0]!r}; choose from {', '.join(allowed)}")
     return dict(value)
+
+
+def option_paths(options_type) -> dict[str, tuple[str, ...]]:
+    """Every option of a frozen options dataclass by its flat name: name -> the path of fields to it.
+
+    A field whose default is itself a dataclass is a group, walked in turn; its options are named by
+    their own field names, which are unique across the groups (a planner file's keys, a CLI flag's).
+    """
+    paths = {}
+    for f in dataclasses.fields(options_type):
+        if dataclasses.is_dataclass(f.default):
+            paths |= {name: (f.name, *path) for name, path in option_paths(type(f.default)).items()}
+        else:
+            paths[f.name] = (f.name,)
+    return paths
+
+
+def flat_options(options) -> dict:
+    """The options of a frozen options dataclass (groups included) by flat name, in field order."""
+    values = {}
+    for name, path in option_paths(type(options)).items():
+        value = options
+        for field_name in path:
+            value = getattr(value, field_name)
+        values[name] = value
+    return values
+
+
+def with_options(options, values: dict, *, what: str, error: type[InputError] = InputError):
+    """``options`` (a frozen options dataclass) with the flat-named ``values`` put in; each group changed is
+    built anew, so its own checks run. A name no option has is refused by name, listing the options."""
+    paths = option_paths(type(options))
+    unknown = [name for name in values if name not in paths]
+    if unknown:
+        raise error(f"{what}: unknown option {unknown[0]!r}; choose from {', '.join(paths)}")
+    grouped: dict[str, dict] = {}
+    for name, value in values.items():
+        head, *rest = paths[name]
+        grouped.setdefault(head, {})
+        if rest:
+            grouped[head][name] = value
+        else:
+            grouped[head] = value
+    changed = {head: with_options(getattr(options, head), value, what=what, error=error)
+               if dataclasses.is_dataclass(getattr(options, head)) else value for head, value in grouped.items()}
+    return dataclasses.replace(options, **changed) if changed else options
 
 
 # --- perception ---

@@ -9,20 +9,23 @@ from hypothesis import strategies as st
 import contourgrasp as cg
 from contourgrasp.io.planner_file import PlannerFileError, load_planner, parse_planner, planner_names
 from contourgrasp.synthesis import search
+from contourgrasp.validation import with_options
 
 
 def test_presets_load_and_paper_is_the_thesis():
     assert {"paper", "default"} <= set(planner_names())
-    paper = load_planner("paper").plan_options
-    assert paper["harmonics"] == 4 and paper["xy_step"] == 0.05 and paper["d_min"] == 0.015
-    assert paper["yaw_step"] == pytest.approx(math.radians(2.0))
-    assert "depth_mode" in paper and "depth_mode" not in load_planner("paper").synthesis_options
+    paper = load_planner("paper")
+    assert paper.options.search.harmonics == 4 and paper.options.search.grid.xy_step == 0.05
+    assert paper.options.search.grid.d_min == 0.015
+    assert paper.options.search.grid.yaw_step == pytest.approx(math.radians(2.0))
+    assert dict(paper.settings)["depth_mode"] == paper.options.perception.depth_mode == "max"
 
 
 @pytest.mark.parametrize("name", ["paper", "default"])
 def test_preset_options_are_accepted_by_synthesis(name):
-    options = load_planner(name).synthesis_options | {"xy_step": 0.03, "yaw_step": math.radians(15)}
-    plan = search(cg.example_contour("can"), cg.load_hand("three-finger"), **options)
+    options = with_options(load_planner(name).options.search, {"xy_step": 0.03, "yaw_step": math.radians(15)},
+                           what="test")
+    plan = search(cg.example_contour("can"), cg.load_hand("three-finger"), options)
     assert plan.grid.xy_step == 0.03
 
 
@@ -32,9 +35,10 @@ def test_a_file_round_trips_its_options(tmp_path):
                     'finger_thickness = true\nclearance = 0.005\n')
     planner = load_planner(str(path))
     assert planner.name == "mine"
-    assert planner.plan_options == {"harmonics": "adaptive", "d_max": (0.1, 0.12), "footprint": True,
-                                    "finger_thickness": True, "clearance": 0.005}
-    assert "footprint" not in planner.synthesis_options
+    assert dict(planner.settings) == {"harmonics": "adaptive", "d_max": (0.1, 0.12), "footprint": True,
+                                      "finger_thickness": True, "clearance": 0.005}
+    assert planner.options.perception.footprint is True and planner.options.search.grid.d_max == (0.1, 0.12)
+    assert planner.options.search.safeguards.clearance == 0.005 and planner.options.search.harmonics == "adaptive"
 
 
 @pytest.mark.parametrize("text, field", [
@@ -77,7 +81,7 @@ def test_cli_takes_the_planner_and_lets_flags_override_it(tmp_path, capsys):
     assert main([*args, "--planner", "paper", "--xy-step", "0.03"]) == 0
     assert json.loads(out.read_text())["grid"]["xy_step"] == 0.03
     assert main([*args]) == 0  # the default planner
-    assert json.loads(out.read_text())["grid"]["xy_step"] == dict(load_planner("default").options)["xy_step"]
+    assert json.loads(out.read_text())["grid"]["xy_step"] == load_planner("default").options.search.grid.xy_step
     out.unlink()
     assert main([*args, "--planner", "nosuch"]) == 2
     assert "unknown planner 'nosuch'" in capsys.readouterr().err and not out.exists()
@@ -147,8 +151,8 @@ def test_fuzz_load_planner_on_random_bytes_gives_a_planner_or_a_planner_file_err
 
 def test_the_slice_contour_is_a_flag_unbalanced_or_the_hands():
     planner = parse_planner('name = "x"\nslice_contour = "unbalanced"', source="mine.toml")
-    assert planner.plan_options["slice_contour"] == "unbalanced"
-    assert parse_planner('name = "x"\nslice_contour = "hand"').plan_options["slice_contour"] == "hand"
+    assert planner.options.scene.slice_contour == "unbalanced"
+    assert parse_planner('name = "x"\nslice_contour = "hand"').options.scene.slice_contour == "hand"
     with pytest.raises(PlannerFileError, match="mine.toml.*slice_contour"):
         parse_planner('name = "x"\nslice_contour = "sometimes"', source="mine.toml")
 
@@ -156,5 +160,6 @@ def test_the_slice_contour_is_a_flag_unbalanced_or_the_hands():
 def test_the_scene_keys_are_plan_options_not_search_options():
     planner = parse_planner('name = "x"\ndescent = true\ngrasp_height = 0.05\nslice_contour = false\n'
                             'closing_sweep = true\nsmall_objects = true\nxy_step = 0.02', source="mine.toml")
-    assert planner.plan_options["grasp_height"] == 0.05 and planner.plan_options["descent"] is True
-    assert planner.synthesis_options == {"small_objects": True, "xy_step": 0.02}  # the rule is the search's
+    assert planner.options.scene.grasp_height == 0.05 and planner.options.scene.descent is True
+    assert planner.options.search.small_objects is True  # the rule is the search's
+    assert planner.options.search.grid.xy_step == 0.02

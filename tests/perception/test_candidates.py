@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 
 import contourgrasp as cg
-from contourgrasp.pipeline import plan_frame
 from contourgrasp.cli import main
 from contourgrasp.errors import PerceptionError, SegmentationError
 from contourgrasp.io.camera_file import read_rgbd
@@ -169,8 +168,8 @@ def test_target_by_roi():
 def test_plan_frame_plans_on_the_chosen_target_and_lists_the_candidates():
     depth = scene(A, B, C)
     hand = cg.load_hand("three-finger")
-    default = plan_frame(None, depth, CAMERA, hand, **FAST)
-    chosen = plan_frame(None, depth, CAMERA, hand, target_px=(490, 310), **FAST)
+    default = cg.plan_grasp(None, depth, CAMERA, hand, **FAST)
+    chosen = cg.plan_grasp(None, depth, CAMERA, hand, target_px=(490, 310), **FAST)
     assert default.target.bbox[:2] == A[:2] and chosen.target.bbox[:2] == B[:2]
     np.testing.assert_array_equal(chosen.segmentation.mask, chosen.target.mask)
     data = image_plan_to_dict(chosen)
@@ -179,12 +178,12 @@ def test_plan_frame_plans_on_the_chosen_target_and_lists_the_candidates():
                                   "extent": pytest.approx([39 * 0.62 / 525] * 2, rel=1e-6),
                                   "centroid_px": [499.5, 319.5], "in_view": True, "bbox": [480, 300, 40, 40]}
     assert data["target"] == {"label": 3, "reason": "the candidate under pixel (490, 310)"}
-    by_roi = plan_frame(None, depth, CAMERA, hand, roi=(470, 290, 20, 20), **FAST)
+    by_roi = cg.plan_grasp(None, depth, CAMERA, hand, roi=(470, 290, 20, 20), **FAST)
     np.testing.assert_allclose(by_roi.T_camera_hand, chosen.T_camera_hand)
     with pytest.raises(SegmentationError, match="not completely visible"):
-        plan_frame(None, depth, CAMERA, hand, target_px=(10, 100), **FAST)
+        cg.plan_grasp(None, depth, CAMERA, hand, target_px=(10, 100), **FAST)
     with pytest.raises(PerceptionError, match="not with a mask"):
-        plan_frame(None, depth, CAMERA, hand, mask=default.segmentation.mask, target_px=(490, 310))
+        cg.plan_grasp(None, depth, CAMERA, hand, mask=default.segmentation.mask, target_px=(490, 310))
 
 
 def test_the_bundled_frame_lists_the_grippers_fingers_as_candidates_not_in_view():
@@ -416,7 +415,7 @@ def test_a_step_within_an_object_leaves_it_whole():
 
 
 def test_planning_on_the_object_in_the_bin_takes_its_region_not_the_walls():
-    result = plan_frame(None, bin_with_box(), CAMERA, cg.load_hand("five-finger-linear"), target_px=(250, 230),
+    result = cg.plan_grasp(None, bin_with_box(), CAMERA, cg.load_hand("five-finger-linear"), target_px=(250, 230),
                         segment="depth", **FAST)
     assert result.segmentation.mask.sum() == 60 * 60
 
@@ -424,7 +423,7 @@ def test_planning_on_the_object_in_the_bin_takes_its_region_not_the_walls():
 def test_in_grey_the_wall_an_object_was_split_from_is_no_flat_part_of_it():
     """Grey images take flat-part evidence from the heights; the wall beside the box stands, but is another object."""
     grey = np.full((H, W, 3), 128, dtype=np.uint8)
-    result = plan_frame(grey, bin_with_box(), CAMERA, cg.load_hand("five-finger-linear"), target_px=(250, 230),
+    result = cg.plan_grasp(grey, bin_with_box(), CAMERA, cg.load_hand("five-finger-linear"), target_px=(250, 230),
                         **FAST)
     assert result.segmentation.mask.sum() == 60 * 60
 

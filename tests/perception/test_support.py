@@ -79,9 +79,7 @@ def test_plan_frame_in_a_bin_plans_on_the_object_not_on_the_walls():
 
     import contourgrasp as cg
     from contourgrasp.io.plan_file import image_plan_to_dict
-    from contourgrasp.pipeline import plan_frame
-
-    result = plan_frame(None, bin_scene(), CAMERA, cg.load_hand("three-finger"), xy_step=0.03, yaw_step=math.radians(6))
+    result = cg.plan_grasp(None, bin_scene(), CAMERA, cg.load_hand("three-finger"), xy_step=0.03, yaw_step=math.radians(6))
     assert result.target.area_px == 2400 and result.segmentation.area_px == 2400
     assert result.support.plane.offset == pytest.approx(FLOOR, abs=1e-6)
     data = image_plan_to_dict(result)["support_surface"]
@@ -125,10 +123,8 @@ def test_a_tilted_noisy_bin_with_missing_readings_plans_on_the_object():
     import math
 
     import contourgrasp as cg
-    from contourgrasp.pipeline import plan_frame
-
     depth = tilted_bin()
-    result = plan_frame(None, depth, CAMERA, cg.load_hand("three-finger"), xy_step=0.03, yaw_step=math.radians(6))
+    result = cg.plan_grasp(None, depth, CAMERA, cg.load_hand("three-finger"), xy_step=0.03, yaw_step=math.radians(6))
     assert math.degrees(result.support.plane.tilt) == pytest.approx(8.8, abs=0.5)
     assert "mm above the dominant one" in result.support.reason
     conveyor = result.support.planes[0]

@@ -200,8 +200,8 @@ def test_the_node_plans_with_one_blas_thread_and_leaves_the_process_its_own(rig,
     import contourgrasp.ros.node as node_module
 
     node, camera = rig
-    during, plan_grasp = [], node_module.plan_grasp
-    monkeypatch.setattr(node_module, "plan_grasp", lambda *a, **k: during.append(blas_threads()) or plan_grasp(*a, **k))
+    during, plan_frame = [], node_module.plan_frame
+    monkeypatch.setattr(node_module, "plan_frame", lambda *a, **k: during.append(blas_threads()) or plan_frame(*a, **k))
     with threadpool_limits(limits=2, user_api="blas"):
         assert blas_threads() == {2}
         camera.send(node, *good_frame())
@@ -258,7 +258,7 @@ def _ros_command(*ros_args):
 
 
 @pytest.mark.parametrize("ros_args, message", [
-    (["-p", "segment:=bogus"], "parameter segment: must be one of auto, rgb, depth, got 'bogus'"),
+    (["-p", "segment:=bogus"], "parameter segment: must be one of 'auto', 'rgb', 'depth', got 'bogus'"),
     (["-p", "bogus"], "contourgrasp: error: ROS arguments: failed to initialize rcl: Couldn't parse parameter"),
 ], ids=["refused-parameter", "unparsable-argument"])
 def test_the_ros_command_exits_2_with_one_line_for_bad_arguments(ros_args, message):

@@ -16,7 +16,7 @@ wider than its fingertips and its palm is a box, so its band is wider (:data:`BA
 import numpy as np
 import pytest
 
-from contourgrasp import load_hand, pipeline
+from contourgrasp import load_hand, pipeline, plan_grasp
 from contourgrasp.hand import to_image
 from contourgrasp.handmodels.mount import mount_model
 from contourgrasp.sim.objects import soda_can
@@ -40,7 +40,7 @@ def sampled(request):
     hand, simulated = (load_hand(name),) * 2 if name == "five-finger-linear" else _mounted(name)
     scene = build_scene(soda_can(standing=True), seed=3, hand=simulated)
     rgb, depth = render(scene, noise=False)
-    planned = pipeline.plan_frame(rgb, depth, scene.camera.intrinsics, hand, xy_step=0.02, yaw_step=0.2)
+    planned = plan_grasp(rgb, depth, scene.camera.intrinsics, hand, xy_step=0.02, yaw_step=0.2)
     centre = planned.metric.contour_xy.mean(axis=0)
     rng = np.random.default_rng(7)
     n = 240

@@ -10,9 +10,9 @@ from contourgrasp.hand import to_image
 from contourgrasp.io.planner_file import load_planner
 from contourgrasp.pipeline import plan_frame
 from contourgrasp.sim import build_scene, render
-from contourgrasp.sim.planners import (ABLATION_STEPS, ablation_planners, centroid_pose, library_defaults, make_planner,
-                                       random_feasible_pose, search_settings)
+from contourgrasp.sim.planners import ABLATION_STEPS, ablation_planners, centroid_pose, make_planner, random_feasible_pose
 from contourgrasp.synthesis import evaluate_poses
+from contourgrasp.validation import flat_options
 
 HAND = contourgrasp.load_hand("five-finger-linear")
 
@@ -44,22 +44,20 @@ def test_centroid_pose_centres_the_hand_with_the_thumb_on_the_minor_axis():
 
 def test_random_pose_is_feasible_and_seeded():
     contour = contourgrasp.example_contour("case")
-    settings = search_settings("paper")
-    poses = [random_feasible_pose(contour, HAND, np.random.default_rng(seed), settings) for seed in (0, 0, 1)]
+    options = load_planner("paper").options.search
+    poses = [random_feasible_pose(contour, HAND, np.random.default_rng(seed), options) for seed in (0, 0, 1)]
     np.testing.assert_array_equal(poses[0], poses[1])
     assert not np.array_equal(poses[0], poses[2])
-    model = contourgrasp.contour.fit(contourgrasp.contour.clean_polygon(contour), settings["harmonics"])
-    assert evaluate_poses(model, HAND, np.array(poses), d_min=settings["grid"].d_min).feasible.all()
+    model = contourgrasp.contour.fit(contourgrasp.contour.clean_polygon(contour), options.harmonics)
+    assert evaluate_poses(model, HAND, np.array(poses), d_min=options.grid.d_min).feasible.all()
 
 
 def test_ablation_walks_from_paper_to_default_one_group_at_a_time():
     steps = ablation_planners()
-    default = load_planner("default").plan_options
-    effective = library_defaults(default) | dict(steps[-1].options)  # unset options take the library's default
-    assert steps[0].name == "paper" and effective == library_defaults(default) | default
+    assert steps[0].name == "paper" and steps[-1].options == load_planner("default").options
     groups = dict(ABLATION_STEPS)
     for before, after in zip(steps, steps[1:]):
-        changed = {k for k in dict(before.options) | dict(after.options)
-                   if dict(before.options).get(k) != dict(after.options).get(k)}
+        ahead, behind = flat_options(after.options), flat_options(before.options)
+        changed = {k for k in ahead if ahead[k] != behind[k]}
         step = after.name.rsplit("+", 1)[1]
         assert changed and (step == "other" or changed <= set(groups[step]))

@@ -6,6 +6,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+import contourgrasp as cg
 from contourgrasp import load_hand
 from contourgrasp.errors import HandError, NoFeasibleGrasp, PerceptionError, PlannerError
 from contourgrasp.hand import Hand, SampledChain, chain_joints, chain_tip
@@ -307,13 +308,13 @@ def test_the_search_keeps_the_open_hand_clear_of_a_tall_object(hand):
     contour = circle(r)
     heights = scene(lambda x, y: np.where(np.hypot(x, y) <= r, 0.12, 0.0))
     options = dict(xy_step=0.01, yaw_step=math.radians(8))
-    flat = synthesis.search(contour, hand, **options)
+    flat = cg.synthesize(contour, hand, **options)
     assert descent_clearance(hand, heights, [flat.pose], 0.02).min() < 0  # the 2-D plan strikes
-    plan = synthesis.search(contour, hand, descent=Descent(heights, 0.02, 0.08), **options)
+    plan = cg.synthesize(contour, hand, descent=Descent(heights, 0.02, 0.08), **options)
     assert plan.descent.feasible[0] and plan.descent.clearance.min() >= plan.descent.margin - 1e-9
     assert 0.02 <= plan.descent.tip_height[0] <= 0.08
     with pytest.raises(NoFeasibleGrasp, match="strike the scene"):
-        synthesis.search(contour, hand, descent=Descent(heights, 0.02, 0.02, margin=0.3), **options)
+        cg.synthesize(contour, hand, descent=Descent(heights, 0.02, 0.02, margin=0.3), **options)
 
 
 def test_descent_options_are_checked(hand):
@@ -324,10 +325,10 @@ def test_descent_options_are_checked(hand):
         Descent("map", 0.05, 0.05)
     with pytest.raises(PlannerError, match="descent must be"):
         from contourgrasp import synthesis
-        synthesis.search(np.array([[0, 0], [0.05, 0], [0.05, 0.05]]), hand, descent="yes")
+        cg.synthesize(np.array([[0, 0], [0.05, 0], [0.05, 0.05]]), hand, descent="yes")
     with pytest.raises(HandError, match="no 3-D geometry"):
         from contourgrasp import synthesis
-        synthesis.search(np.array([[0, 0], [0.05, 0], [0.05, 0.05]]), load_hand("five-finger-curved-thumb"),
+        cg.synthesize(np.array([[0, 0], [0.05, 0], [0.05, 0.05]]), load_hand("five-finger-curved-thumb"),
                          descent=Descent(heights, 0.05, 0.05))
 
 
@@ -339,7 +340,7 @@ def test_a_pose_blocked_only_by_a_neighbour_says_so(hand):
     contour = circle(r)
     heights = ringed_column(r, 0.05, (0.04, 0.06), 0.15)
     with pytest.raises(NoFeasibleGrasp, match="blocked by a neighbouring object or the bin wall"):
-        synthesis.search(contour, hand, descent=Descent(heights, 0.02, 0.02), xy_step=0.01, yaw_step=math.radians(8))
+        cg.synthesize(contour, hand, descent=Descent(heights, 0.02, 0.02), xy_step=0.01, yaw_step=math.radians(8))
 
 
 def test_a_low_ring_the_closing_fingers_would_cross_blocks_every_pose_and_says_so(hand):
@@ -351,11 +352,11 @@ def test_a_low_ring_the_closing_fingers_would_cross_blocks_every_pose_and_says_s
     contour = circle(r)
     heights = ringed_column(r, 0.05, (0.02, 0.025), 0.015)
     options = dict(xy_step=0.01, yaw_step=math.radians(8))
-    plan = synthesis.search(contour, hand, descent=Descent(heights, 0.02, 0.02), **options)
+    plan = cg.synthesize(contour, hand, descent=Descent(heights, 0.02, 0.02), **options)
     assert plan.descent.feasible[0]  # without the closing check the hand would close through the kerb
     with pytest.raises(NoFeasibleGrasp, match="blocked by a neighbouring object or the bin wall: .* would run a "
                                               "finger into a neighbouring object or the bin wall while the hand closes"):
-        synthesis.search(contour, hand, descent=Descent(heights, 0.02, 0.02, closing=True), **options)
+        cg.synthesize(contour, hand, descent=Descent(heights, 0.02, 0.02, closing=True), **options)
 
 
 def test_a_yes_no_walk_is_exact_below_its_threshold_and_no_lower_above_it(hand):

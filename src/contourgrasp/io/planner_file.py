@@ -1,4 +1,4 @@
-"""Planner files (TOML): named settings of :func:`contourgrasp.pipeline.plan_frame`, and the presets.
+"""Planner files (TOML): named :class:`~contourgrasp.pipeline.PlanOptions`, and the presets.
 
 A planner is the part of a plan that is not the hand: how the contour is
 modelled, how finely poses are searched, which safeguards apply. ``paper``
@@ -54,13 +54,11 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 
 from .. import tolerances as tol
 from ..errors import PlannerError, PlannerFileError
+from ..pipeline import PlanOptions
+from ..validation import with_options
 from . import _toml_files
 
 _PRESET_DIR = "data/planners"
-#: Options that belong to perception, and to planning in the scene's 3-D (the rest are
-#: :func:`contourgrasp.synthesis.search`'s).
-PERCEPTION_OPTIONS = ("depth_mode", "footprint")
-SCENE_OPTIONS = ("descent", "grasp_height", "slice_contour", "closing_sweep", "closing_obstacles", "low_objects")
 
 Positive = Annotated[float, Field(gt=0, le=tol.MAX_SEARCH_LENGTH, allow_inf_nan=False)]
 Distance = Annotated[float, Field(ge=0, le=tol.MAX_SEARCH_LENGTH, allow_inf_nan=False)]
@@ -125,34 +123,29 @@ class _PlannerSchema(BaseModel):
 
 @dataclass(frozen=True)
 class Planner:
-    """Named options of :func:`contourgrasp.pipeline.plan_frame`.
+    """A named set of :class:`~contourgrasp.pipeline.PlanOptions`.
 
     Attributes
     ----------
     name : str
     description : str
-    options : tuple of (str, value)
-        The options the file sets, in schema order (``d_max`` as a tuple).
+    settings : tuple of (str, value)
+        The options the file sets, by flat name in schema order (``d_max`` as a tuple).
+    options : PlanOptions
+        Every option: the file's settings over the defaults, built once (:meth:`from_settings`).
     """
 
     name: str
     description: str
-    options: tuple[tuple[str, object], ...]
+    settings: tuple[tuple[str, object], ...]
+    options: PlanOptions
 
-    @property
-    def plan_options(self) -> dict:
-        """Keyword options of :func:`contourgrasp.pipeline.plan_frame`."""
-        return dict(self.options)
-
-    @property
-    def synthesis_options(self) -> dict:
-        """Keyword options of :func:`contourgrasp.synthesis.search` (perception's left out)."""
-        return synthesis_options(dict(self.options))
-
-
-def synthesis_options(options: dict) -> dict:
-    """The options of :func:`contourgrasp.pipeline.plan_frame` that :func:`contourgrasp.synthesis.search` takes."""
-    return {k: v for k, v in options.items() if k not in PERCEPTION_OPTIONS + SCENE_OPTIONS}
+    @classmethod
+    def from_settings(cls, name: str, description: str, settings) -> Planner:
+        """The planner setting ``settings`` ((flat name, value) pairs) over the defaults; PlannerError naming a bad one."""
+        settings = tuple(settings)
+        return cls(name, description, settings,
+                   with_options(PlanOptions(), dict(settings), what=f"planner {name!r}", error=PlannerError))
 
 
 def planner_names() -> list[str]:
@@ -165,7 +158,7 @@ def load_planner(spec) -> Planner:
 
     Examples
     --------
-    >>> load_planner("paper").synthesis_options["harmonics"]
+    >>> load_planner("paper").options.search.harmonics
     4
     """
     if isinstance(spec, Planner):
@@ -187,7 +180,7 @@ def parse_planner(text: str, *, source: str = "<string>") -> Planner:
         if key in ("name", "description") or value is None:
             continue
         options.append((key, tuple(value) if isinstance(value, list) else value))
-    return Planner(schema.name, schema.description, tuple(options))
+    return Planner.from_settings(schema.name, schema.description, options)
 
 
 def _describe(err: ValidationError) -> str:

@@ -25,6 +25,7 @@ One module per stage, in the order the pipeline runs them:
   frame, the object's cells marked (:class:`HeightMap`)
 * :mod:`~contourgrasp.perception.cross_section` -- the object's outline at a height, from the height
   map (:func:`cross_section`)
+* :mod:`~contourgrasp.perception.options` -- how a frame is read (:class:`PerceptionOptions`)
 
 Conventions: see :mod:`~contourgrasp.perception.camera`. The thresholds are in
 :mod:`contourgrasp.tolerances`; measured results (IoU against the hand-made
@@ -41,6 +42,7 @@ from .colour import add_flat_parts, colour_offset, register_colour
 from .cross_section import cross_section
 from .height_map import HeightMap, height_map
 from .metric import DEPTH_MODES, DepthMode, MetricContour, approach_depth, contour_to_metric
+from .options import PerceptionOptions
 from .region import Segmentation, mask_contour
 from .segment_depth import object_footprint, open_table_holes, segment_depth
 from .segment_rgb import segment_rgb
@@ -49,7 +51,7 @@ from .support import Support, find_support
 from .table import Plane, fit_plane, fit_table_plane
 
 __all__ = [
-    "Candidate", "DEPTH_MODES", "DepthMode", "HeightMap", "Intrinsics", "MetricContour", "PerceptionError", "PerceptionWarning", "Plane",
+    "Candidate", "DEPTH_MODES", "DepthMode", "HeightMap", "Intrinsics", "MetricContour", "PerceptionError", "PerceptionOptions", "PerceptionWarning", "Plane",
     "SEGMENT_METHODS", "SegmentMethod", "Segmentation", "SegmentationError", "Support", "TARGET_RULES", "add_flat_parts", "approach_depth",
     "as_depth", "backproject", "choose_target", "colour_offset", "contour_to_metric", "denoised_depth", "fill_depth_holes",
     "cross_section", "find_candidates", "find_support", "fit_plane", "fit_table_plane", "hand_opening", "height_map", "low_part_candidate", "mask_contour", "object_footprint", "one_frame", "open_table_holes", "register_colour", "segment",

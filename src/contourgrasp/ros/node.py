@@ -25,7 +25,7 @@ import signal
 import time
 import warnings
 from collections import deque
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import rclpy
 from geometry_msgs.msg import PoseStamped
@@ -38,36 +38,39 @@ from sensor_msgs.msg import CameraInfo, Image
 from std_srvs.srv import Trigger
 from visualization_msgs.msg import MarkerArray
 
-from .. import load_hand, load_planner, plan_grasp
 from ..errors import InputError, NoFeasibleGrasp
 from ..hand import Hand
+from ..io.hand_file import load_hand
 from ..io.plan_file import image_plan_to_dict
-from ..io.planner_file import Planner
+from ..io.planner_file import Planner, load_planner
+from ..pipeline import PlanOptions, plan_frame
 from ..threads import one_blas_thread
 from . import messages
+from ..validation import with_options
 from .pairing import PAIR_TOLERANCE, Pairer
 
 #: QoS of the subscriptions: best effort (it receives from reliable publishers too), a queue of one, so that a
 #: node busy planning goes on with the newest images rather than falling behind the camera.
+#: The options' defaults, which the parameters' defaults are.
+DEFAULTS = PlanOptions()
 NEWEST = QoSProfile(depth=1, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.BEST_EFFORT)
 
-SEGMENT_CHOICES = ("auto", "rgb", "depth")
 DEPTH_MODE_CHOICES = ("", "max", "plane")
 
 #: The node's parameters: name -> (default, description). Read once at start (read-only).
 PARAMETERS = {
     "hand": ("five-finger-linear", "hand preset name or hand TOML file"),
     "planner": ("default", "planner preset name or planner TOML file"),
-    "segment": ("auto", "segmentation: auto, rgb or depth"),
-    "approach_offset": (0.01, "added to the nearest depth inside the contour, m"),
-    "standoff": (0.10, "pre-grasp distance back along the approach axis, m"),
+    "segment": (DEFAULTS.perception.segment, "segmentation: auto, rgb or depth"),
+    "approach_offset": (DEFAULTS.perception.approach_offset, "added to the nearest depth inside the contour, m"),
+    "standoff": (DEFAULTS.standoff, "pre-grasp distance back along the approach axis, m"),
     "pair_tolerance": (PAIR_TOLERANCE, "largest stamp difference of a colour and a depth image paired, s"),
     "continuous": (False, "plan every paired frame, not only on ~/plan"),
     "harmonics": (0, "EFD harmonics; 0: the planner's"),
     "xy_step": (0.0, "grid step in x and y, m; 0: the planner's"),
     "yaw_step_deg": (0.0, "grid step in yaw, degrees; 0: the planner's"),
     "depth_mode": ("", "contour plane: max or plane; empty: the planner's"),
-    "top_k": (10, "ranked distinct poses in the plan JSON"),
+    "top_k": (DEFAULTS.search.top_k, "ranked distinct poses in the plan JSON"),
     "target": ([-1, -1], "pixel [u, v] of the depth image: plan on the object under it; [-1, -1]: the default rule"),
 }
 
@@ -78,13 +81,15 @@ NO_TARGET = (-1, -1)
 
 @dataclass(frozen=True)
 class Settings:
-    """The node's validated parameters: the hand, the planner and the keyword options of ``plan_grasp``."""
+    """The node's validated parameters: the hand, the planner, the options planned with (the planner's, with the
+    node's parameters put in) and the target pixel (None: the default rule)."""
 
     hand: Hand
     planner: Planner
     pair_tolerance: float
     continuous: bool
-    options: dict = field(default_factory=dict)
+    options: PlanOptions = DEFAULTS
+    target_px: tuple[int, int] | None = None
 
 
 def settings_from_parameters(values: dict) -> Settings:
@@ -92,22 +97,28 @@ def settings_from_parameters(values: dict) -> Settings:
     v = {name: default for name, (default, _) in PARAMETERS.items()} | values
     hand = _loaded("hand", load_hand, v["hand"])
     planner = _loaded("planner", load_planner, v["planner"])
-    _require(v["segment"] in SEGMENT_CHOICES, "segment", f"must be one of {', '.join(SEGMENT_CHOICES)}", v)
     _require(v["depth_mode"] in DEPTH_MODE_CHOICES, "depth_mode", "must be max, plane or empty", v)
-    _require(math.isfinite(v["approach_offset"]), "approach_offset", "must be a finite distance in m", v)
-    for name in ("standoff", "xy_step", "yaw_step_deg"):
-        _require(math.isfinite(v[name]) and v[name] >= 0, name, "must be a finite number >= 0", v)
+    for name in ("xy_step", "yaw_step_deg"):
+        _require(math.isfinite(v[name]) and v[name] >= 0, name, "must be a finite number >= 0 (0: the planner's)", v)
     _require(math.isfinite(v["pair_tolerance"]) and v["pair_tolerance"] > 0, "pair_tolerance",
              "must be a positive time in s", v)
     _require(v["harmonics"] >= 0, "harmonics", "must be an integer >= 0 (0: the planner's)", v)
-    _require(v["top_k"] >= 1, "top_k", "must be a positive integer", v)
-    target = target_pixel(v["target"])
-    options = {"segment": v["segment"], "approach_offset": v["approach_offset"], "standoff": v["standoff"],
-               "top_k": v["top_k"]} | ({} if target is None else {"target_px": target})
     overrides = {"harmonics": v["harmonics"], "xy_step": v["xy_step"], "yaw_step": math.radians(v["yaw_step_deg"]),
                  "depth_mode": v["depth_mode"]}
-    options |= {name: value for name, value in overrides.items() if value}
-    return Settings(hand, planner, v["pair_tolerance"], v["continuous"], options)
+    given = {"segment": v["segment"], "approach_offset": v["approach_offset"], "standoff": v["standoff"],
+             "top_k": v["top_k"]} | {name: value for name, value in overrides.items() if value}
+    for name, value in given.items():  # one at a time, so that the message names the parameter refused
+        try:
+            with_options(planner.options, {name: value}, what="parameters", error=InputError)
+        except InputError as err:
+            parameter = PARAMETER_OF.get(name, name)
+            raise InputError(f"parameter {parameter}: {str(err).removeprefix(name + ' ')}") from None
+    options = with_options(planner.options, given, what="parameters", error=InputError)
+    return Settings(hand, planner, v["pair_tolerance"], v["continuous"], options, target_pixel(v["target"]))
+
+
+#: The parameter that sets an option, where their names differ.
+PARAMETER_OF = {"yaw_step": "yaw_step_deg"}
 
 
 def target_pixel(value) -> tuple[int, int] | None:
@@ -190,15 +201,13 @@ class ContourGraspNode(Node):
 
     def _on_set_parameters(self, parameters):
         """Check a new ``target`` (the only parameter not read-only) and take it for the next plans."""
-        options = dict(self.settings.options)
+        target_px = self.settings.target_px
         for parameter in (p for p in parameters if p.name in WRITABLE):
             try:
-                pixel = target_pixel(parameter.value)
+                target_px = target_pixel(parameter.value)
             except InputError as err:  # ROS itself refuses a value that is not an integer array
                 return SetParametersResult(successful=False, reason=str(err))
-            options.pop("target_px", None)
-            options |= {} if pixel is None else {"target_px": pixel}
-        self.settings = replace(self.settings, options=options)
+        self.settings = replace(self.settings, target_px=target_px)
         return SetParametersResult(successful=True)
 
     def _subscribe(self) -> None:
@@ -260,8 +269,8 @@ class ContourGraspNode(Node):
         with warnings.catch_warnings(record=True) as caught, one_blas_thread():
             warnings.simplefilter("always")
             rgb, d, intrinsics = messages.rgbd_arrays(colour, depth, self.camera_info)
-            result = plan_grasp(rgb, d, intrinsics, self.settings.hand, planner=self.settings.planner,
-                                **self.settings.options)
+            result = plan_frame(rgb, d, intrinsics, self.settings.hand, self.settings.options,
+                                target_px=self.settings.target_px)
         for w in caught:
             self.get_logger().warning(str(w.message))
         return result

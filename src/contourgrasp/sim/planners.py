@@ -38,7 +38,6 @@ Baselines (:data:`BASELINES`), to show whether the bench tells good from bad
 
 from __future__ import annotations
 
-import inspect
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -46,11 +45,12 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from ..contour import clean_polygon, fit
+from ..contour import choose_harmonics, clean_polygon, fit
 from .. import perception, pipeline, synthesis
 from ..errors import HandError, NoFeasibleGrasp, SimulationError
 from ..hand import Hand, Ray, to_image
 from ..io.planner_file import Planner, load_planner, planner_names
+from ..validation import flat_options
 
 #: The ablation from ``paper`` to ``default``: each step takes ``default``'s values of these options. Then come
 #: the 3-D hand's steps (issue 16): finger bodies against the height map (with the executor's old grasp height),
@@ -131,12 +131,12 @@ class _Planner:
 
 @dataclass(frozen=True)
 class SynthesisPlanner(_Planner):
-    """:func:`contourgrasp.pipeline.plan_frame` with fixed options ((name, value) pairs)."""
+    """:func:`contourgrasp.pipeline.plan_frame` with fixed options."""
 
-    options: tuple[tuple[str, object], ...] = ()
+    options: pipeline.PlanOptions = pipeline.PlanOptions()
 
     def plan(self, rgb, depth, intrinsics, *, target_px=None) -> PlannedGrasp:
-        result = pipeline.plan_frame(rgb, depth, intrinsics, self.hand, target_px=target_px, **dict(self.options))
+        result = pipeline.plan_frame(rgb, depth, intrinsics, self.hand, self.options, target_px=target_px)
         return PlannedGrasp(result.plan.pose, result.T_camera_hand, result.metric.approach_depth,
                             result.segmentation, result.metric, result.camera, result.plan, result.grasp_height)
 
@@ -159,7 +159,7 @@ class RandomPlanner(_Planner):
     def plan(self, rgb, depth, intrinsics, *, target_px=None) -> PlannedGrasp:
         segmentation, metric, _ = pipeline.perceive(rgb, depth, intrinsics, target_px=target_px)
         rng = np.random.default_rng([self.seed, 2])  # streams 0 and 1 place the object and add noise
-        pose = random_feasible_pose(metric.contour_xy, self.hand, rng, search_settings(RANDOM_REGION))
+        pose = random_feasible_pose(metric.contour_xy, self.hand, rng, load_planner(RANDOM_REGION).options.search)
         return _planned(pose, segmentation, metric, intrinsics)
 
 
@@ -171,17 +171,17 @@ def ablation_planners() -> tuple[Planner, ...]:
     last step has ``default``'s effective options.
     """
     paper, default = load_planner("paper"), load_planner("default")
-    options, target = dict(paper.options), dict(default.options)
-    defaults = library_defaults(set(options) | set(target))
+    options, target = dict(paper.settings), dict(default.settings)
+    defaults = flat_options(pipeline.PlanOptions())
     steps, name = [paper], paper.name
     for step, keys in ABLATION_STEPS:
         changed = {k: target[k] for k in keys if k in target and options.get(k, defaults.get(k)) != target[k]}
         if changed:
             options |= changed
             name += f"+{step}"
-            steps.append(Planner(name, f"paper with default's {', '.join(changed)}", tuple(options.items())))
+            steps.append(Planner.from_settings(name, f"paper with default's {', '.join(changed)}", options.items()))
     if defaults | options != defaults | target:  # options outside every step (e.g. curvature) make a last step
-        steps.append(Planner(name + "+other", "paper with all of default's options", default.options))
+        steps.append(Planner.from_settings(name + "+other", "paper with all of default's options", default.settings))
     return tuple(steps)
 
 
@@ -224,24 +224,6 @@ def make_planner(name: str, hand: Hand, *, seed: int = 0) -> _Planner:
     raise AssertionError(f"baseline {name!r} has no planner")  # BASELINES and this function disagree
 
 
-def library_defaults(names) -> dict:
-    """The defaults of the options ``names`` of :func:`contourgrasp.pipeline.plan_frame` and of synthesis."""
-    defaults = {}
-    for function in (pipeline.plan_frame, synthesis.search):
-        for name, parameter in inspect.signature(function).parameters.items():
-            if name in names and parameter.default is not inspect.Parameter.empty:
-                defaults[name] = parameter.default
-    return defaults
-
-
-def search_settings(name: str) -> dict:
-    """Harmonics, curvature and the :class:`~contourgrasp.synthesis.SearchGrid` synthesis planner ``name`` uses."""
-    keys = ("harmonics", "curvature", "xy_step", "yaw_step", "d_max", "d_min")
-    options = library_defaults(keys) | {k: v for k, v in load_planner(name).options if k in keys}
-    grid = synthesis.SearchGrid(**{k: options[k] for k in ("xy_step", "yaw_step", "d_max", "d_min")})
-    return {"harmonics": options["harmonics"], "curvature": options["curvature"], "grid": grid}
-
-
 def centroid_pose(contour_xy, hand: Hand) -> np.ndarray:
     """(3,) float: the pose putting ``hand.grasp_centre`` on the polygon's centroid, thumb along its minor axis."""
     moments = cv2.moments(np.asarray(contour_xy, dtype=np.float32))
@@ -265,26 +247,29 @@ def _thumb_direction(hand: Hand) -> tuple[float, float]:
     return finger.trajectory.closing_direction
 
 
-def random_feasible_pose(contour_xy, hand: Hand, rng: np.random.Generator, settings: dict) -> np.ndarray:
+def random_feasible_pose(contour_xy, hand: Hand, rng: np.random.Generator,
+                         options: synthesis.SearchOptions) -> np.ndarray:
     """(3,) float: a pose uniform over the search region's feasible poses (rejection sampling).
 
-    ``settings`` is :func:`search_settings`'s: the region is the grid's x and y
-    extent around the EFD locus (as :func:`~contourgrasp.synthesis.search`
-    would search it) and any yaw; feasibility is
-    :func:`~contourgrasp.synthesis.evaluate_poses`'s with the grid's D_min.
+    The region is the ``options.grid``'s x and y extent around the EFD locus (as
+    :func:`~contourgrasp.synthesis.search` would search it) and any yaw; feasibility is
+    :func:`~contourgrasp.synthesis.evaluate_poses`'s with the grid's D_min, and the EFD model has the
+    options' harmonics and curvature.
 
     Raises
     ------
     NoFeasibleGrasp
         None of ``RANDOM_BATCH * RANDOM_BATCHES`` poses drawn is feasible.
     """
-    model = fit(clean_polygon(contour_xy), settings["harmonics"], validate=False)
-    grid = settings["grid"]
+    contour = clean_polygon(contour_xy)
+    harmonics = choose_harmonics(contour, validate=False) if options.harmonics == "adaptive" else options.harmonics
+    model = fit(contour, harmonics, validate=False)
+    grid = options.grid
     xs, ys, _ = grid.axes(model.locus)
     low, high = np.array([xs[0], ys[0], 0.0]), np.array([xs[-1], ys[-1], 2 * math.pi])
     for _ in range(RANDOM_BATCHES):
         poses = rng.uniform(low, high, size=(RANDOM_BATCH, 3))
-        feasible = synthesis.evaluate_poses(model, hand, poses, curvature=settings["curvature"],
+        feasible = synthesis.evaluate_poses(model, hand, poses, curvature=options.curvature,
                                             d_min=grid.d_min).feasible
         if feasible.any():
             return poses[np.argmax(feasible)]

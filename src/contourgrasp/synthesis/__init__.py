@@ -14,6 +14,8 @@
 * :mod:`~contourgrasp.synthesis.refine` — continuous refinement off the grid (:func:`refine_poses`);
 * :mod:`~contourgrasp.synthesis.descent` — the open 3-D hand's descent onto the scene's height map
   (:class:`Descent`, :func:`descent_feasible`, :func:`descent_floor`), a constraint of the search;
+* :mod:`~contourgrasp.synthesis.options` — the search's options and the 3-D hand's (:class:`SearchOptions`,
+  :class:`SceneOptions`);
 * :mod:`~contourgrasp.synthesis.outer` — the search itself (eq 3.32, :func:`search`);
 * :mod:`~contourgrasp.synthesis.plan` — what it returns (:class:`GraspPlan`, :class:`Cost`, ...).
 
@@ -25,13 +27,14 @@ from .descent import Descent, DescentCheck, descent_clearance, descent_feasible,
 from .evaluate import evaluate_poses
 from .grid import SearchGrid, distinct_best, screen_grid, screen_reaching
 from .inner import closest_approach, first_touch
+from .options import SceneOptions, SearchOptions
 from .outer import search
 from .plan import Alternative, Cost, FingerContact, GraspPlan, Refinement
 from .refine import refine_poses
 from .safeguards import Safeguards, fingers_clear, grasp_epsilon, grasp_imbalance
 
 __all__ = [
-    "Alternative", "Cost", "Descent", "DescentCheck", "FingerContact", "GraspPlan", "PoseEvaluation", "Refinement", "Safeguards",
+    "Alternative", "Cost", "Descent", "DescentCheck", "FingerContact", "GraspPlan", "PoseEvaluation", "Refinement", "Safeguards", "SceneOptions", "SearchOptions",
     "SearchGrid", "closest_approach", "descent_clearance", "descent_feasible", "descent_floor", "distance", "distinct_best", "evaluate_poses", "fingers_clear",
     "first_touch", "grasp_epsilon", "grasp_imbalance", "ratio_cost", "refine_poses", "screen_grid", "screen_reaching", "search",
 ]

@@ -43,31 +43,17 @@ from .grid import SearchGrid, distinct_best, screen_reaching
 from .inner import closest_approach
 from .plan import Alternative, Cost, FingerContact, GraspPlan, Refinement
 from .refine import refine_poses
+from .options import SearchOptions
 from .safeguards import Safeguards, grasp_epsilon, grasp_imbalance
 
 
 def search(
     contour_xy,
     hand: Hand,
+    options: SearchOptions = SearchOptions(),
     *,
-    harmonics: int | Literal["adaptive"] = 4,
-    curvature: CurvatureMode = "paper",
-    xy_step: float = 0.05,
-    yaw_step: float = math.radians(2.0),
-    d_max=(0.15, 0.15),
-    d_min: float = 0.015,
-    top_k: int = 10,
-    refine: bool = False,
-    finger_thickness: bool = False,
-    clearance: float = 0.0,
-    friction: float = 0.5,
-    require_closure: bool = False,
-    quality_gain: float = 0.0,
-    centring_gain: float = 0.0,
-    max_imbalance: float | Literal["hand"] = 1.0,
     balance_required: bool = False,
     balanced_alternative: Callable[[], GraspPlan] | None = None,
-    small_objects: bool = False,
     low_object: bool = False,
     descent: Descent | None = None,
 ) -> GraspPlan:
@@ -82,30 +68,13 @@ def search(
         Closed object contour in the image plane, meters, either orientation.
     hand : Hand
         (:func:`contourgrasp.synthesize` also takes a preset name or a TOML path.)
-    harmonics : int or "adaptive"
-        EFD harmonics (thesis: 4; at most ``tolerances.MAX_HARMONICS``); ``"adaptive"`` chooses
-        them per object (:func:`contourgrasp.contour.choose_harmonics` with its defaults).
-    curvature : {"paper", "geometric"}
-        Curvature flavour of the cost, see :mod:`contourgrasp.contour`.
-    xy_step, yaw_step : float
-        Grid resolution, m and rad (Table 4.1: 0.05 m, 2 deg).
-    d_max : float or (2,) float
-        D_max,x and D_max,y, m (Table 4.2: 0.15).
-    d_min : float
-        D_min, m (Table 4.2: 0.015).
-    top_k : int
-        Number of distinct ranked poses to keep in ``alternatives``.
-    refine : bool
-        After the grid, refine its best ``tol.REFINE_STARTS`` distinct poses continuously
-        (:func:`~contourgrasp.synthesis.refine_poses`, under the same constraints) and keep the
-        better; ``refinement`` reports the gain.
-    finger_thickness, clearance, friction, require_closure, quality_gain, centring_gain, max_imbalance
-        The :class:`~contourgrasp.synthesis.Safeguards` (all off: the thesis's problem).
-        ``friction`` is also the mu of the plan's reported ``quality``.
-    max_imbalance : float or "hand"
-        ``"hand"``: the hand's own, :attr:`Hand.max_imbalance` (what its fingers' drive can hold).
-        A balanced squeeze is preferred, not required: when no pose meets it (with the small-object
-        rule's fewer fingers too), the search is repeated without it, and the plan's notes say so.
+    options : SearchOptions
+        The EFD model, the grid, the safeguards and the rules (their defaults: the thesis's problem).
+        With ``refine`` the grid's best ``tol.REFINE_STARTS`` distinct poses are refined continuously
+        and the better kept; ``refinement`` reports the gain. ``safeguards.friction`` is also the mu
+        of the plan's reported ``quality``. A balanced squeeze (``safeguards.max_imbalance``) is
+        preferred, not required: when no pose meets it (with the small-object rule's fewer fingers
+        too), the search is repeated without it, and the plan's notes say so.
     balance_required : bool
         Required instead: no pose balanced within ``max_imbalance`` is no feasible grasp (how
         :func:`contourgrasp.pipeline.plan_frame` searches the cross-section, whose plan it takes only
@@ -117,27 +86,11 @@ def search(
         called while the fingertips cannot reach the object as points: the outline grown by their
         radius is balanced first. How :func:`contourgrasp.pipeline.plan_frame` turns to the
         object's cross-section where its outline seen has no balanced pose.
-    small_objects : bool
-        The small-object rule: when no pose satisfies the constraints with the hand's
-        ``min_touching`` fingers, search again with fewer touching fingers, down to
-        ``tolerances.SMALL_OBJECT_TOUCHING`` (the thumb, or the hand's required fingers, against
-        one other). A one-DoF power grasp of a small object closes the whole hand, but only the
-        thumb and the fingers opposite it reach the object. With ``max_imbalance`` the same rule
-        plans the thumb against the one or two fingers that balance it on objects of any size
-        (four fingers along one side outpush one thumb). The plan's ``hand`` has the
-        ``min_touching`` it was planned with. Last, when even the fewest fingers cannot reach the
-        object within their travel, the fingertips are taken as what they are, balls of the
-        fingers' ``radius``: a ball touches the object when its centre meets the outline grown by
-        its radius (:func:`~contourgrasp.contour.grow_polygon`), so the search is repeated on that
-        outline, grown by the smallest radius (a finger of radius 0 is a point: no growth). The
-        thesis's point fingertips cannot close on an object smaller than the gap their travels
-        leave (35 mm between the five-finger hand's thumb and index); the balls of a real hand do.
-        The plan's ``grown`` says so, and its notes.
     low_object : bool
-        The low-object rule (the caller judges the object low: :func:`contourgrasp.pipeline.plan_frame`'s
+        The low-object rule (the caller judges the object low: :class:`SceneOptions`'s
         ``low_objects``). First plan a pinch: the thumb against one finger (``tolerances.SMALL_OBJECT_TOUCHING``
         touching, or the hand's required fingers), the fingertips as balls (the outline grown by the
-        smallest finger ``radius``, as above), and no ``miss_penalty`` for the fingers that close on air,
+        smallest finger ``radius``, as below), and no ``miss_penalty`` for the fingers that close on air,
         which would otherwise prefer poses where they touch too; only where no such pose is feasible,
         the search as without it. Our reading of why: a one-DoF hand lifts a flat object lying on the table
         between thumb and index, the balls' sides meeting its edges, while the other fingers, arriving on
@@ -149,6 +102,22 @@ def search(
         (:mod:`~contourgrasp.synthesis.descent`; the hand must be 3-D). Checked exactly on the
         candidates in increasing cost, after their inner problem, until one passes. Without it:
         the thesis's 2-D problem.
+
+    Notes
+    -----
+    The small-object rule (``options.small_objects``): when no pose satisfies the constraints with the
+    hand's ``min_touching`` fingers, search again with fewer touching fingers, down to
+    ``tolerances.SMALL_OBJECT_TOUCHING`` (the thumb, or the hand's required fingers, against one other). A
+    one-DoF power grasp of a small object closes the whole hand, but only the thumb and the fingers
+    opposite it reach the object. With ``max_imbalance`` the same rule plans the thumb against the one or
+    two fingers that balance it on objects of any size (four fingers along one side outpush one thumb).
+    The plan's ``hand`` has the ``min_touching`` it was planned with. Last, when even the fewest fingers
+    cannot reach the object within their travel, the fingertips are taken as what they are, balls of the
+    fingers' ``radius``: a ball touches the object when its centre meets the outline grown by its radius
+    (:func:`~contourgrasp.contour.grow_polygon`), so the search is repeated on that outline, grown by the
+    smallest radius (a finger of radius 0 is a point: no growth). The thesis's point fingertips cannot
+    close on an object smaller than the gap their travels leave (35 mm between the five-finger hand's
+    thumb and index); the balls of a real hand do. The plan's ``grown`` says so, and its notes.
 
     Returns
     -------
@@ -165,39 +134,29 @@ def search(
     Examples
     --------
     >>> from contourgrasp import example_contour, load_hand
-    >>> plan = search(example_contour("can"), load_hand("three-finger"), yaw_step=np.radians(10))
+    >>> options = SearchOptions(grid=SearchGrid(yaw_step=np.radians(10)))
+    >>> plan = search(example_contour("can"), load_hand("three-finger"), options)
     >>> [f.missed for f in plan.fingers]
     [False, False, False]
     """
-    check.choice("curvature", curvature, CURVATURE_MODES, error=PlannerError)
-    _check_harmonics(harmonics)
-    check.integer("top_k", top_k, 1, maximum=tol.MAX_GRID_POSES, error=PlannerError)
-    refine = check.flag("refine", refine, error=PlannerError)
+    if not isinstance(options, SearchOptions):
+        raise PlannerError(f"options must be a contourgrasp.synthesis.SearchOptions, got {type(options).__name__}")
     if not isinstance(hand, Hand):
         raise HandError(f"hand must be a Hand, got {type(hand).__name__} (contourgrasp.synthesize loads names)")
     if descent is not None:
         if not isinstance(descent, Descent):
             raise PlannerError(f"descent must be a contourgrasp.synthesis.Descent, got {type(descent).__name__}")
         body_names(hand)  # refuses a hand without 3-D geometry
-    grid = SearchGrid(xy_step=xy_step, yaw_step=yaw_step, d_max=d_max, d_min=d_min)
-    if isinstance(max_imbalance, str):
-        check.choice("max_imbalance", max_imbalance, ("hand",), error=PlannerError)
-        max_imbalance = hand.max_imbalance
-    safeguards = Safeguards(finger_thickness=check.flag("finger_thickness", finger_thickness, error=PlannerError),
-                            clearance=clearance, friction=friction,
-                            require_closure=check.flag("require_closure", require_closure, error=PlannerError),
-                            quality_gain=quality_gain, max_imbalance=max_imbalance, centring_gain=centring_gain)
+    safeguards = options.safeguards.for_hand(hand)
 
     clock = time.perf_counter()
-    small_objects = check.flag("small_objects", small_objects, error=PlannerError)
     preferred = not check.flag("balance_required", balance_required, error=PlannerError)
     contour = clean_polygon(contour_xy)
     if balanced_alternative is not None and not callable(balanced_alternative):
         raise PlannerError(f"balanced_alternative must be callable, got {type(balanced_alternative).__name__}")
     elsewhere = _Elsewhere(balanced_alternative)
-    outline = partial(_search_outline, hand=hand, grid=grid, safeguards=safeguards, descent=descent,
-                      harmonics=harmonics, curvature=curvature, small_objects=small_objects, top_k=top_k,
-                      refine=refine, clock=clock, fallback=preferred, alternative=elsewhere)
+    outline = partial(_search_outline, hand=hand, options=replace(options, safeguards=safeguards), descent=descent,
+                      clock=clock, fallback=preferred, alternative=elsewhere)
     radius = min(f.radius for f in hand.fingers)
     if check.flag("low_object", low_object, error=PlannerError) and radius > 0:
         pinch = replace(hand, min_touching=_fewest_touching(hand), miss_penalty=0.0)
@@ -209,7 +168,7 @@ def search(
     try:
         return outline(contour)
     except _OutOfReach as points:
-        if not small_objects or radius <= 0:
+        if not options.small_objects or radius <= 0:
             raise NoFeasibleGrasp(points.reason) from None
         try:
             plan = outline(_grown(contour, radius))
@@ -237,21 +196,22 @@ def _fewest_touching(hand: Hand) -> int:
     return min(hand.min_touching, max(tol.SMALL_OBJECT_TOUCHING, sum(f.required for f in hand.fingers)))
 
 
-def _search_outline(contour, *, hand: Hand, grid: SearchGrid, safeguards: Safeguards, descent: Descent | None,
-                    harmonics, curvature, small_objects: bool, top_k: int, refine: bool, clock: float,
+def _search_outline(contour, *, hand: Hand, options: SearchOptions, descent: Descent | None, clock: float,
                     fallback: bool = True, alternative: _Elsewhere) -> GraspPlan:
     """:func:`search` on one cleaned outline: fit, screen, then each attempt of the small-object rule and the
     squeeze's balance in turn, then the ``alternative``'s plan, then (``fallback``) without the balance.
     Raises :class:`_OutOfReach` when, with the fewest touching fingers tried, no pose brings them onto the
     object within their travel."""
+    harmonics, grid, safeguards = options.harmonics, options.grid, options.safeguards
     if harmonics == "adaptive":
         harmonics = choose_harmonics(contour, validate=False)
     model = efd.fit(contour, harmonics, validate=False)
     fitted = time.perf_counter()
-    fewest = _fewest_touching(hand) if small_objects else hand.min_touching
+    fewest = _fewest_touching(hand) if options.small_objects else hand.min_touching
     counts = range(hand.min_touching, fewest - 1, -1)
     screen, touch_counts, any_outside = screen_reaching(model, replace(hand, min_touching=fewest), grid,
-                                                        curvature=curvature, centring_gain=safeguards.centring_gain)
+                                                        curvature=options.curvature,
+                                                        centring_gain=safeguards.centring_gain)
     share = np.full(len(screen.poses), np.nan)  # the squeeze's balance per screened pose, filled as attempts need it
     searched = time.perf_counter()
     errors = []
@@ -263,7 +223,7 @@ def _search_outline(contour, *, hand: Hand, grid: SearchGrid, safeguards: Safegu
             try:
                 return _search_fitted(model, contour, replace(hand, min_touching=touching),
                                       _needing(screen, touch_counts, touching), grid, guards, descent,
-                                      curvature=curvature, top_k=top_k, refine=refine,
+                                      curvature=options.curvature, top_k=options.top_k, refine=options.refine,
                                       times=(clock, fitted, searched), share=share, any_outside=any_outside)
             except NoFeasibleGrasp as err:  # kept without its traceback: through this frame that would make a
                 errors.append(err.with_traceback(None))  # cycle holding every screen until the gc runs
@@ -415,15 +375,6 @@ def _search_fitted(model: EFD, contour, hand: Hand, screen: PoseEvaluation, grid
         quality=grasp_quality,
         descent=descended,
     )
-
-
-def _check_harmonics(harmonics) -> None:
-    """An integer in 1..``tolerances.MAX_HARMONICS`` or ``"adaptive"``."""
-    if isinstance(harmonics, str) and harmonics == "adaptive":
-        return
-    if isinstance(harmonics, str) or isinstance(harmonics, bool) or not isinstance(harmonics, (int, np.integer)):
-        raise PlannerError(f"harmonics must be an integer or 'adaptive', got {harmonics!r}")
-    check.integer("harmonics", harmonics, 1, maximum=tol.MAX_HARMONICS, error=PlannerError)
 
 
 def _reevaluate_best(model, hand, screen: PoseEvaluation, n: int, curvature, d_min,

@@ -8,7 +8,8 @@ away before every finger touches). All off, :class:`Safeguards` is the thesis's 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import Literal
 
 import numpy as np
 
@@ -64,7 +65,7 @@ class Safeguards:
         hand does not choose its forces, and an unbalanced squeeze pushes the object away
         before the last finger arrives or slides it out as the fingers close. A constraint of
         each evaluation; :func:`~contourgrasp.synthesis.search` prefers it, and plans without it
-        (with a note) when no pose meets it.
+        (with a note) when no pose meets it. ``"hand"``: the hand's own (:meth:`for_hand`).
 
     Raises
     ------
@@ -77,7 +78,7 @@ class Safeguards:
     friction: float = 0.5
     require_closure: bool = False
     quality_gain: float = 0.0
-    max_imbalance: float = 1.0
+    max_imbalance: float | Literal["hand"] = 1.0
     centring_gain: float = 0.0
 
     def __post_init__(self):
@@ -86,12 +87,21 @@ class Safeguards:
         check.friction("friction", self.friction, tol.MAX_FRICTION, error=PlannerError)
         check.flag("require_closure", self.require_closure, error=PlannerError)
         check.non_negative("quality_gain", self.quality_gain, error=PlannerError)
-        check.bounded("max_imbalance", self.max_imbalance, 1.0, "", error=PlannerError)
+        if isinstance(self.max_imbalance, str):
+            check.choice("max_imbalance", self.max_imbalance, ("hand",), error=PlannerError)
+        else:
+            check.bounded("max_imbalance", self.max_imbalance, 1.0, "", error=PlannerError)
         check.bounded("centring_gain", self.centring_gain, tol.MAX_CENTRING_GAIN, "", error=PlannerError)
+
+    def for_hand(self, hand: Hand) -> Safeguards:
+        """These safeguards with ``max_imbalance = "hand"`` read as ``hand``'s own (:attr:`Hand.max_imbalance`)."""
+        return replace(self, max_imbalance=hand.max_imbalance) if self.max_imbalance == "hand" else self
 
     @property
     def balances(self) -> bool:
         """The squeeze's imbalance is a constraint."""
+        if self.max_imbalance == "hand":
+            raise PlannerError('max_imbalance "hand" is read for a hand first (Safeguards.for_hand)')
         return self.max_imbalance < 1.0
 
     @property

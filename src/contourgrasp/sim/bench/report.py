@@ -230,7 +230,7 @@ def planner_notes(bench: Bench, results) -> list[str]:
         if settings is None:
             notes.append(f"- `{planner}` (baseline): {BASELINES[planner]}.{timing}")
             continue
-        text = ", ".join(f"{k}={_option(k, v)}" for k, v in settings.options) or "the library's defaults"
+        text = ", ".join(f"{k}={_option(k, v)}" for k, v in settings.settings) or "the library's defaults"
         notes.append(f"- `{planner}`: `plan_grasp` with {text}.{timing}")
     return notes
 
