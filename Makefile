@@ -12,7 +12,7 @@ venv: $(STAMP)
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
-	$(BIN)/pip install --quiet -e '.[test,cluster,ycb,ros]'
+	$(BIN)/pip install --quiet -e '.[test,sim,cluster,ycb,ros]'
 	touch $(STAMP)
 
 test: $(STAMP)

@@ -51,20 +51,23 @@ import cv2  # noqa: E402
 import numpy as np  # noqa: E402
 
 from contourgrasp import perception, pipeline  # noqa: E402
-from contourgrasp.io.camera_file import read_rgbd  # noqa: E402
+from contourgrasp.io.camera_file import read_masked_frames, read_rgbd  # noqa: E402
 from contourgrasp.sim import build_scene, render  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from segmentation import default_data  # noqa: E402
-from segmentation import frames as real_frames  # noqa: E402
-from segmentation import grey  # noqa: E402
-
 SIM_OBJECTS = ("can", "case", "bottle", "stone1", "stone2")
+#: The shared real frames (``../shared/data``, or ``$CONTOURGRASP_SHARED_DATA``).
+SHARED_DATA = Path(os.environ.get("CONTOURGRASP_SHARED_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
 BAR_CLAMP = Path(__file__).resolve().parents[1] / "examples" / "bar_clamp"
 STAGES = ("fill", "segment", "metric", "perceive")
 CLOCKS = {"cpu": time.process_time, "wall": time.perf_counter}
 #: Perception's share of the planner's 100 ms budget per frame.
 TARGET_MS = 40.0
+
+
+def grey(rgb) -> np.ndarray:
+    """(H, W, 3) uint8: ``rgb``'s luma (ITU-R 601) in three equal channels, as a grayscale camera stores it."""
+    luma = np.rint(np.asarray(rgb, dtype=float) @ [0.299, 0.587, 0.114]).astype(np.uint8)
+    return np.repeat(luma[..., None], 3, axis=2)
 
 
 def sim_frames(seeds: int):
@@ -134,7 +137,7 @@ def table(results: dict, baseline: dict) -> list[str]:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--data", type=Path, default=default_data(), help="shared data folder")
+    parser.add_argument("--data", type=Path, default=SHARED_DATA, help="shared data folder")
     parser.add_argument("--runs", type=int, default=7, help="timed runs per frame; the median is kept")
     parser.add_argument("--seeds", type=int, default=2, help="simulated scenes per object")
     parser.add_argument("--clock", choices=sorted(CLOCKS), default="cpu", help="process CPU time or wall time")
@@ -144,7 +147,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     cv2.setNumThreads(1)
     frames = list(sim_frames(args.seeds))
-    real = [(name, rgb, depth, intrinsics) for name, rgb, depth, intrinsics, _ in real_frames(args.data)]
+    real = [(name, f.rgb, f.depth, f.intrinsics) for name, f in read_masked_frames(args.data / "rgbd")]
     if not real:
         print(f"no real frames under {args.data}/rgbd: simulated frames and the bar clamp only", file=sys.stderr)
     real.insert(0, bundled_frame())

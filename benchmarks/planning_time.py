@@ -1,4 +1,4 @@
-"""Planning time per frame (issues 6 and 16: under 100 ms): `plan_grasp` on simulated frames, per planner.
+"""Planning time per frame (the target: under 100 ms): `plan_frame` on simulated frames, per planner.
 
 One simulated RGB-D frame per thesis object (seed 3 unless ``--seed``, depth noise on), planned with
 the `five-finger-linear` hand: perception, synthesis and the 6-DoF pose, exactly
@@ -36,6 +36,7 @@ from pathlib import Path  # noqa: E402
 import cv2  # noqa: E402
 
 from contourgrasp import load_hand, pipeline  # noqa: E402
+from contourgrasp.io.camera_file import read_masked_frames  # noqa: E402
 from contourgrasp.io.planner_file import load_planner  # noqa: E402
 from contourgrasp.errors import NoFeasibleGrasp  # noqa: E402
 from contourgrasp.sim import build_scene, render  # noqa: E402
@@ -56,15 +57,15 @@ def frame_times(planner: str, frame, clock=time.perf_counter, runs: int = RUNS) 
     its median synthesis time, ms."""
     rgb, depth, camera = frame
     hand = load_hand("five-finger-linear")
-    options = load_planner(planner).plan_options
+    options = load_planner(planner).options
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         walls, synthesis = [], []
         try:
-            pipeline.plan_frame(rgb, depth, camera, hand, **options)  # warm-up: numba's compilation, caches
+            pipeline.plan_frame(rgb, depth, camera, hand, options)  # warm-up: numba's compilation, caches
             for _ in range(runs):
                 start = clock()
-                result = pipeline.plan_frame(rgb, depth, camera, hand, **options)
+                result = pipeline.plan_frame(rgb, depth, camera, hand, options)
                 walls.append(1e3 * (clock() - start))
                 synthesis.append(result.plan.timing_ms["total"])
         except NoFeasibleGrasp:
@@ -74,10 +75,8 @@ def frame_times(planner: str, frame, clock=time.perf_counter, runs: int = RUNS) 
 
 def real_frames() -> dict:
     """name -> (rgb, depth, intrinsics) of the real frames with hand-made masks (none without the shared data)."""
-    sys.path.insert(0, str(Path(__file__).resolve().parent))
-    from segmentation import default_data, frames
-
-    return {name.rsplit("/", 1)[-1]: (rgb, depth, intrinsics) for name, rgb, depth, intrinsics, _ in frames(default_data())}
+    shared = Path(os.environ.get("CONTOURGRASP_SHARED_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
+    return {name.rsplit("/", 1)[-1]: (f.rgb, f.depth, f.intrinsics) for name, f in read_masked_frames(shared / "rgbd")}
 
 
 def main() -> None:

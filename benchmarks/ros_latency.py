@@ -1,4 +1,4 @@
-"""Frame-to-pose latency of the warm ``contourgrasp`` ROS 2 node (issue 18: target <= 100 ms).
+"""Frame-to-pose latency of the warm ``contourgrasp`` ROS 2 node.
 
 A second node publishes the bundled bar-clamp frame (examples/bar_clamp) as
 sensor_msgs/Image (rgb8, 32FC1) and CameraInfo, a new stamp per frame, to the
@@ -39,13 +39,21 @@ from rclpy.node import Node  # noqa: E402
 from rclpy.parameter import Parameter  # noqa: E402
 from sensor_msgs.msg import CameraInfo, Image  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "ros"))
-from frames import bar_clamp, camera_info, image, spin_until  # noqa: E402
-
-from contourgrasp.ros.messages import stamp_seconds  # noqa: E402
+from contourgrasp.io.camera_file import read_rgbd  # noqa: E402
+from contourgrasp.ros.messages import camera_info_message, image_message, stamp_seconds  # noqa: E402
 from contourgrasp.ros.node import ContourGraspNode  # noqa: E402
 
 TIMEOUT = 60.0
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "bar_clamp"
+FRAME_ID = "camera_color_optical_frame"
+
+
+def spin_until(executor, done, timeout: float) -> bool:
+    """Spin until ``done()`` or ``timeout`` seconds; whether ``done()``."""
+    deadline = time.monotonic() + timeout
+    while not done() and time.monotonic() < deadline:
+        executor.spin_once(timeout_sec=0.02)
+    return bool(done())
 
 
 def measure(frames: int, warmup: int, planner: str, hand: str) -> tuple[list[float], list[float], float]:
@@ -63,9 +71,9 @@ def measure(frames: int, warmup: int, planner: str, hand: str) -> tuple[list[flo
     info_pub = camera.create_publisher(CameraInfo, "color/camera_info", 5)
     for n in (node, camera):
         executor.add_node(n)
-    rgb, depth, intrinsics = bar_clamp()
-    depth32 = depth.astype(np.float32)
-    info = camera_info(intrinsics)
+    frame = read_rgbd(EXAMPLE / "color_0.png", EXAMPLE / "depth_0.npy", EXAMPLE / "primesense_overhead_color.intr")
+    rgb, depth32 = frame.rgb, frame.depth.astype(np.float32)
+    info = camera_info_message(frame.intrinsics, 0.0, FRAME_ID)
     try:
         while not spin_until(executor, lambda: node.camera_info is not None, 0.25):
             info_pub.publish(info)
@@ -74,7 +82,7 @@ def measure(frames: int, warmup: int, planner: str, hand: str) -> tuple[list[flo
             if i == warmup:
                 cpu = time.process_time()
             stamp = 100.0 + i
-            colour, d = image(rgb, "rgb8", stamp), image(depth32, "32FC1", stamp)
+            colour, d = image_message(rgb, "rgb8", stamp, FRAME_ID), image_message(depth32, "32FC1", stamp, FRAME_ID)
             colour_pub.publish(colour)
             sent = time.perf_counter()
             depth_pub.publish(d)

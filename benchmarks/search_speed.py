@@ -1,8 +1,8 @@
-"""Search-speed benchmark (issue 5): the library's grid search against the thesis's nested optimisation.
+"""Search-speed benchmark: the library's grid search against the thesis's nested optimisation.
 
 For every example contour and hand preset, in one process, on one core:
 
-(a) the reference (``reference_nested.reference_search``: scipy L-BFGS-B per finger per pose) on the
+(a) the reference (``contourgrasp.synthesis.reference.reference_search``: scipy L-BFGS-B per finger per pose) on the
     thesis grid (xy_step 0.05 m, yaw_step 2 deg, D_max 0.15 m: 7 x 7 x 180 = 8820 poses), one run;
 (b) the library (``contourgrasp.synthesis.search``) on the thesis grid;
 (c) the library on the dense grid (xy_step 0.01 m, yaw_step 1 deg, D_max 0.15 m: 31 x 31 x 360 =
@@ -24,7 +24,7 @@ Where the library's best cost and the reference's differ by more than 1e-6 (rela
 evaluated at the other's best pose, finger by finger, to tell whether the reference's local solver got
 stuck (library better) or the library missed the pose (library worse).
 
-The targets of issue 5 are printed with the measured figures; the benchmark is not tuned to them.
+The targets are printed with the measured figures; the benchmark is not tuned to them.
 
 Usage::
 
@@ -58,12 +58,12 @@ import scipy  # noqa: E402
 from matplotlib.path import Path as MplPath  # noqa: E402
 
 import contourgrasp as cg  # noqa: E402
-from contourgrasp import efd, synthesis  # noqa: E402
+from contourgrasp import synthesis  # noqa: E402
+from contourgrasp.contour import clean_polygon, efd  # noqa: E402
 from contourgrasp import tolerances as tol  # noqa: E402
 from contourgrasp.hand import to_image  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from reference_nested import CURVE_SAMPLES, pose_cost, reference_search, solve_inner  # noqa: E402
+from contourgrasp.synthesis.reference import CURVE_SAMPLES, pose_cost, reference_search, solve_inner  # noqa: E402
 
 THESIS = {"xy_step": 0.05, "yaw_step": math.radians(2.0), "d_max": (0.15, 0.15)}
 DENSE = {"xy_step": 0.01, "yaw_step": math.radians(1.0), "d_max": (0.15, 0.15)}
@@ -137,7 +137,7 @@ def run_library(contour, hand, grid: dict, runs: int, refine: bool = False) -> L
     out = LibResult(size=grid_size(grid))
 
     def call():
-        return synthesis.search(contour, hand, d_min=D_MIN, refine=refine, **grid)
+        return cg.synthesize(contour, hand, d_min=D_MIN, refine=refine, **grid)
 
     try:  # warm-up: numba compilation / cache loading, first-touch of every code path
         out.plan = call()
@@ -176,7 +176,7 @@ class Probe:
 
     def __init__(self, contour, hand):
         self.hand = hand
-        self.model = efd.fit(efd.clean_polygon(contour), 4)
+        self.model = efd.fit(clean_polygon(contour), 4)
         self.curve_t, self.curve = efd.sample(self.model, CURVE_SAMPLES)
         self.outline = MplPath(self.curve)
 
@@ -367,7 +367,7 @@ def table(cases: list[Case], machine_tag: str, runs: int) -> list[str]:
 
 
 def targets(cases: list[Case]) -> list[str]:
-    out = ["Targets of issue 5 (measured, not tuned):"]
+    out = ["Targets (measured, not tuned):"]
 
     def worst(key):
         c = max(cases, key=key)
@@ -444,7 +444,7 @@ def main(argv=None) -> int:
     cpu_tag = machine.split(",")[0]
     machine_tag = f"{cpu_tag}, 1 core"
     load_start = load()
-    print("# contourgrasp search-speed benchmark (issue 5)")
+    print("# contourgrasp search-speed benchmark")
     print()
     print(f"Machine: {machine}")
     print(f"Threads: {', '.join(f'{v}=1' for v in THREAD_VARS)} set before importing numpy (one core).")

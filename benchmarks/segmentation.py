@@ -75,7 +75,7 @@ import numpy as np
 
 from contourgrasp import perception, pipeline
 from contourgrasp.errors import InputError
-from contourgrasp.io.camera_file import read_intrinsics, read_mask, read_rgb
+from contourgrasp.io.camera_file import read_masked_frames
 from contourgrasp.perception import SegmentationError, register_colour, segment
 from contourgrasp.sim import (Camera, Intrinsics, build_clutter, build_scene, object_truth, render, target_pixel,
                               tilted_view, truth_labels)
@@ -105,18 +105,8 @@ def default_data() -> Path:
 
 def frames(data: Path):
     """(name, rgb, depth, intrinsics, truth) for every frame with a ground-truth mask."""
-    for truth_path in sorted(data.glob("rgbd/*/segmask_*.png")):
-        folder, index = truth_path.parent, truth_path.stem.removeprefix("segmask_")
-        intrinsics = sorted(folder.glob("*.intr"))
-        if not intrinsics or not (folder / f"depth_{index}.npy").is_file():
-            continue
-        yield (
-            f"{folder.name}/{index}",
-            read_rgb(folder / f"color_{index}.png"),
-            np.load(folder / f"depth_{index}.npy"),
-            read_intrinsics(intrinsics[0]),
-            read_mask(truth_path),
-        )
+    for name, frame in read_masked_frames(data / "rgbd"):
+        yield name, frame.rgb, frame.depth, frame.intrinsics, frame.mask
 
 
 def run(rgb, depth, intrinsics, truth, method, depth_options, repeat):

@@ -357,3 +357,16 @@ def test_bench_on_a_hand_model_runs_and_refuses_mixed_options(tmp_path, capsys):
         code, _, err = run(capsys, "bench", *argv, "--objects", "can", "--trials", "1", "--out", tmp_path / "other")
         assert code == 2 and message in err and len(err.strip().splitlines()) == 1, err
         assert not (tmp_path / "other").exists()
+
+
+def test_the_help_gives_the_options_own_defaults(capsys):
+    """The flags default to None (the planner's value, else the option's); their help quotes the option's default,
+    written out so that ``--help`` does not import the pipeline."""
+    from contourgrasp.pipeline import PlanOptions
+
+    defaults = PlanOptions()
+    assert main(["plan", "--help"]) == 0
+    shown = " ".join(capsys.readouterr().out.split())
+    assert f"(default {defaults.perception.approach_offset:g})" in shown
+    assert f"pre-grasp distance, m (default {defaults.standoff:g})" in shown
+    assert f"(default {defaults.search.top_k})" in shown and f"(default {defaults.perception.segment})" in shown

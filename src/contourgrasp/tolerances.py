@@ -196,6 +196,14 @@ LOW_PART_STEP = 0.01
 #: Largest colour-depth misregistration searched for, pixels in each direction.
 MAX_COLOUR_OFFSET_PX = 8
 
+#: Most pixels of an image read or planned on (25 MP: above every depth camera's and most colour cameras'):
+#: a larger one is refused before it is decoded, not after it has filled the memory.
+MAX_IMAGE_PIXELS = 25_000_000
+
+#: Focal lengths accepted in intrinsics, pixels: a lens of any field of view below 175 deg on an image of at most
+#: ``MAX_IMAGE_PIXELS`` lies well inside.
+FOCAL_RANGE_PX = (1.0, 1e6)
+
 #: The colour-depth registration compares edges over the object's bounding box grown by this, pixels.
 REGISTRATION_MARGIN_PX = 20
 

@@ -28,26 +28,39 @@ import numpy as np
 from .errors import InputError
 
 _REAL = (int, float, np.integer, np.floating)
+#: Characters of a refused value quoted in a message.
+_SHOWN = 40
+
+
+def shown(value) -> str:
+    """``repr(value)`` for a message, cut to a readable length (a refused value may be a 5,000-digit integer)."""
+    text = repr(value)
+    return text if len(text) <= _SHOWN else f"{text[:_SHOWN - 12]}... ({len(text)} characters)"
 
 
 def finite(name: str, value, *, error: type[InputError] = InputError) -> float:
-    """``value`` as a float; refused unless a real, finite number (a bool is not a number)."""
-    if isinstance(value, bool) or not isinstance(value, _REAL) or not math.isfinite(value):
-        raise error(f"{name} must be a finite number, got {value!r}")
+    """``value`` as a float; refused unless a real, finite number (a bool is not a number; nor is an integer
+    beyond float's range)."""
+    try:
+        ok = not isinstance(value, bool) and isinstance(value, _REAL) and math.isfinite(value)
+    except OverflowError:
+        ok = False
+    if not ok:
+        raise error(f"{name} must be a finite number, got {shown(value)}")
     return float(value)
 
 
 def positive(name: str, value, *, error: type[InputError] = InputError) -> float:
     """A finite number > 0."""
     if finite(name, value, error=error) <= 0:
-        raise error(f"{name} must be positive, got {value!r}")
+        raise error(f"{name} must be positive, got {shown(value)}")
     return float(value)
 
 
 def non_negative(name: str, value, *, error: type[InputError] = InputError) -> float:
     """A finite number >= 0."""
     if finite(name, value, error=error) < 0:
-        raise error(f"{name} must be a number >= 0, got {value!r}")
+        raise error(f"{name} must be a number >= 0, got {shown(value)}")
     return float(value)
 
 
@@ -72,9 +85,9 @@ def integer(name: str, value, minimum: int | None = None, *, maximum: int | None
     bad = isinstance(value, bool) or not isinstance(value, (int, np.integer))
     if bad or (minimum is not None and value < minimum):
         bound = "" if minimum is None else f" >= {minimum}"
-        raise error(f"{name} must be an integer{bound}, got {value!r}")
+        raise error(f"{name} must be an integer{bound}, got {shown(value)}")
     if maximum is not None and value > maximum:
-        raise error(f"{name} must be at most {maximum}, got {value}")
+        raise error(f"{name} must be at most {maximum}, got {shown(value)}")
     if odd and value % 2 == 0:
         raise error(f"{name} must be odd, got {value}")
     return int(value)
@@ -88,14 +101,14 @@ def choice(name: str, value, choices, *, error: type[InputError] = InputError):
     """
     value = bool(value) if isinstance(value, np.bool_) else value
     if not any(type(value) is type(c) and value == c for c in choices):
-        raise error(f"{name} must be one of {', '.join(map(repr, choices))}, got {value!r}")
+        raise error(f"{name} must be one of {', '.join(map(repr, choices))}, got {shown(value)}")
     return value
 
 
 def flag(name: str, value, *, error: type[InputError] = InputError) -> bool:
     """A bool (numpy's too); 0, 1 and strings are refused."""
     if not isinstance(value, (bool, np.bool_)):
-        raise error(f"{name} must be True or False, got {value!r}")
+        raise error(f"{name} must be True or False, got {shown(value)}")
     return bool(value)
 
 
@@ -205,7 +218,7 @@ def depth_range(name: str, value, *, error: type[InputError] = InputError) -> tu
     try:
         lo, hi = (finite(name, v, error=error) for v in value)
     except (TypeError, ValueError):
-        raise error(f"{name} must be two numbers (near, far) in meters, got {value!r}") from None
+        raise error(f"{name} must be two numbers (near, far) in meters, got {shown(value)}") from None
     if not 0 <= lo < hi:
         raise error(f"{name} must satisfy 0 <= near < far, got ({lo}, {hi})")
     return lo, hi
@@ -218,7 +231,7 @@ def integers(name: str, value, fields: str, *, error: type[InputError] = InputEr
     if values is None or values.shape != (n,) or not all(
             isinstance(v, (int, np.integer)) and not isinstance(v, bool) for v in values):
         count = {2: "two", 3: "three", 4: "four"}.get(n, str(n))
-        raise error(f"{name} must be {count} integers ({fields}), got {value!r}")
+        raise error(f"{name} must be {count} integers ({fields}), got {shown(value)}")
     return tuple(int(v) for v in values)
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import re
 from pathlib import Path
 
 import cv2
@@ -178,7 +179,11 @@ def test_ros_camera_info_k(tmp_path):
     "fields, message",
     [
         ({key: value for key, value in PLAIN.items() if key != "fy"}, "missing field fy"),
-        (PLAIN | {"fx": -1.0}, "fx must be positive"),
+        (PLAIN | {"fx": -1.0}, r"fx must be a focal length in pixels in \[1, 1e\+06\], got -1"),
+        (PLAIN | {"fx": 1e-300}, r"fx must be a focal length in pixels in \[1, 1e\+06\], got 1e-300"),
+        (PLAIN | {"fy": 1e308}, r"fy must be a focal length in pixels in \[1, 1e\+06\], got 1e\+308"),
+        (PLAIN | {"cx": 1e6}, r"cx must lie within the image or one image size beside it"),
+        (PLAIN | {"width": 10_000, "height": 10_000}, r"a 10000x10000 image has more than 25,000,000 pixels"),
         (PLAIN | {"cx": "middle"}, "cx must be a finite number"),
         (PLAIN | {"height": 0}, "height must be a positive whole number"),
         ({"camera_matrix": {"rows": 3}, "image_width": 640, "image_height": 480}, "missing field camera_matrix.data"),
@@ -190,6 +195,32 @@ def test_bad_intrinsics_name_the_file_and_field(tmp_path, fields, message):
     path = write(tmp_path / "camera.json", json.dumps(fields))
     with pytest.raises(InputError, match=f"camera.json: .*{message}"):
         read_intrinsics(path)
+
+
+@pytest.mark.parametrize("name, text, message", [
+    ("camera.json", '{"fx": ' + "9" * 5000 + "}", "a number too long to be camera data"),
+    ("camera.yaml", "fx: " + "9" * 5000 + "\n", "a number too long to be camera data"),
+    ("camera.yaml", "a: &a [1, 1, 1, 1, 1, 1, 1, 1, 1]\n" + "".join(
+        f"{c}: &{c} [*{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}]\n" for p, c in zip("abcdefgh", "bcdefghi")),
+     "YAML aliases"),
+])
+def test_camera_files_that_would_take_unbounded_work_are_refused_by_name(tmp_path, name, text, message):
+    """A 5,000-digit integer, or a 500-byte YAML alias bomb (an array of gigabytes): one line naming the file."""
+    path = write(tmp_path / name, text)
+    for reader in (read_intrinsics, read_extrinsics):
+        with pytest.raises(InputError, match=f"^{re.escape(str(path))}: {message}"):
+            reader(path)
+
+
+def test_an_image_of_too_many_pixels_is_refused_before_it_is_decoded(tmp_path):
+    import cv2
+
+    cv2.imwrite(str(tmp_path / "big.png"), np.zeros((6000, 5000), np.uint8))  # 30 MP, a few kB of PNG
+    with pytest.raises(InputError, match=r"big.png: a 5000x6000 image has more than 25,000,000 pixels"):
+        read_rgb(tmp_path / "big.png")
+    np.lib.format.open_memmap(tmp_path / "big.npy", mode="w+", dtype=np.float32, shape=(6000, 5000)).flush()
+    with pytest.raises(InputError, match=r"big.npy: a 5000x6000 image has more than 25,000,000 pixels"):
+        read_depth(tmp_path / "big.npy")
 
 
 def test_unreadable_intrinsics(tmp_path):

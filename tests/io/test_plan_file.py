@@ -148,3 +148,36 @@ def test_concurrent_writers_never_leave_a_partial_file(tmp_path):
     watcher.join()
     assert json.loads(out.read_text()) in payloads and set(seen) <= {0, 1}
     assert [p.name for p in tmp_path.iterdir()] == ["plan.json"]
+
+
+def test_a_device_is_written_through_not_replaced(tmp_path):
+    before = os.stat("/dev/null")
+    with atomic_outputs("/dev/null", tmp_path / "a.txt") as (null, a):
+        null.write_text("discarded")
+        a.write_text("kept")
+    after = os.stat("/dev/null")
+    assert stat.S_ISCHR(after.st_mode) and (after.st_ino, after.st_rdev) == (before.st_ino, before.st_rdev)
+    assert (tmp_path / "a.txt").read_text() == "kept" and not list(Path("/dev").glob(".null.*"))
+
+
+def test_a_fifo_is_written_through_to_its_reader(tmp_path):
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    read = []
+    reader = threading.Thread(target=lambda: read.append(fifo.read_text()))
+    reader.start()
+    with atomic_outputs(fifo) as (out,):
+        out.write_text("through the pipe")
+    reader.join(timeout=10)
+    assert read == ["through the pipe"] and stat.S_ISFIFO(os.stat(fifo).st_mode)
+
+
+def test_a_symbolic_link_keeps_pointing_at_its_replaced_target(tmp_path):
+    (tmp_path / "target.json").write_text("old")
+    (tmp_path / "link.json").symlink_to("target.json")
+    (tmp_path / "dangling.json").symlink_to("new.json")
+    with atomic_outputs(tmp_path / "link.json", tmp_path / "dangling.json") as (link, dangling):
+        link.write_text("new")
+        dangling.write_text("created")
+    assert (tmp_path / "link.json").is_symlink() and (tmp_path / "target.json").read_text() == "new"
+    assert (tmp_path / "dangling.json").is_symlink() and (tmp_path / "new.json").read_text() == "created"

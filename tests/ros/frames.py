@@ -7,8 +7,6 @@ on localhost only, so every participant (in this process and in the
 the loopback interface. (Not a conftest.py: tests/ import their conftest by name.)
 """
 
-import array
-import math
 import os
 import random
 import time
@@ -20,12 +18,8 @@ for _name in ("ROS_STATIC_PEERS", "ROS_LOCALHOST_ONLY", "ROS_DISCOVERY_SERVER",
               "FASTRTPS_DEFAULT_PROFILES_FILE", "FASTDDS_DEFAULT_PROFILES_FILE"):
     os.environ.pop(_name, None)
 
-from builtin_interfaces.msg import Time
-from sensor_msgs.msg import CameraInfo, Image
-from std_msgs.msg import Header
-
 from contourgrasp.io.camera_file import read_rgbd
-from contourgrasp.ros.messages import camera_info_fields, image_fields
+from contourgrasp.ros import messages
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "bar_clamp"
 FRAME_ID = "camera_color_optical_frame"
@@ -37,18 +31,16 @@ def bar_clamp():
     return frame.rgb, frame.depth, frame.intrinsics
 
 
-def header(stamp: float) -> Header:
-    sec = math.floor(stamp)
-    return Header(frame_id=FRAME_ID, stamp=Time(sec=sec, nanosec=round((stamp - sec) * 1e9)))
+def header(stamp: float):
+    return messages.header(stamp, FRAME_ID)
 
 
-def image(pixels, encoding: str, stamp: float) -> Image:
-    fields = image_fields(pixels, encoding)
-    return Image(header=header(stamp), **(fields | {"data": array.array("B", fields["data"])}))
+def image(pixels, encoding: str, stamp: float):
+    return messages.image_message(pixels, encoding, stamp, FRAME_ID)
 
 
-def camera_info(intrinsics, stamp: float = 0.0) -> CameraInfo:
-    return CameraInfo(header=header(stamp), **camera_info_fields(intrinsics))
+def camera_info(intrinsics, stamp: float = 0.0):
+    return messages.camera_info_message(intrinsics, stamp, FRAME_ID)
 
 
 def spin_until(executor, done, timeout: float) -> bool:

@@ -117,7 +117,7 @@ def test_camera_info_with_k_all_zero_is_refused():
     info.k = np.zeros(9)
     with pytest.raises(InputError, match="K is all zero"):
         messages.camera_info_to_intrinsics(info)
-    with pytest.raises(InputError, match="camera_info: intrinsics: fx must be positive"):
+    with pytest.raises(InputError, match="camera_info: intrinsics: fx must be a focal length in pixels"):
         messages.camera_info_to_intrinsics(CameraInfo(k=[-1.0, 0, 1, 0, 1, 1, 0, 0, 1], width=2, height=2))
 
 

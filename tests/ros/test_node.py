@@ -244,8 +244,27 @@ def test_continuous_plans_every_frame_without_a_call_and_keeps_the_last_latencie
         _stopped(ros, node, camera)
 
 
+def test_a_frame_stamped_far_ahead_does_not_freeze_the_plan_on_it(ros):
+    """After a frame stamped 1e9 s (a clock jump), ~/plan plans the frame received since, not the old one: a bad
+    current frame answers success false, and the jump is logged."""
+    node, camera = _started(ros, "/jump")
+    try:
+        colour, depth, info = good_frame(stamp=1e9)
+        camera.send(node, colour, depth, info)
+        assert camera.call().success
+        rgb, _, _ = bar_clamp()
+        flat = np.zeros(rgb.shape[:2], np.float32)  # no reading: nothing to plan on
+        camera.send(node, image(rgb, "rgb8", 500.0), image(flat, "32FC1", 500.0))
+        answer = camera.call()
+        assert not answer.success and "no valid reading" in answer.message
+        assert spin_until(camera.executor, lambda: camera.warnings("stamps went back"), TIMEOUT)
+    finally:
+        _stopped(ros, node, camera)
+
+
 @pytest.mark.parametrize("name, value", [("segment", "bogus"), ("hand", "no-such-hand"), ("standoff", -0.1),
                                          ("pair_tolerance", 0.0), ("top_k", 0), ("standoff", 1),
+                                         ("harmonics", 100000), ("xy_step", 1e-9), ("yaw_step_deg", 1e-6),
                                          ("target", [1, 2, 3]), ("target", "centre")])
 def test_an_invalid_parameter_is_refused_at_start_naming_it(ros, name, value):
     context, _ = ros
@@ -259,12 +278,15 @@ def _ros_command(*ros_args):
 
 @pytest.mark.parametrize("ros_args, message", [
     (["-p", "segment:=bogus"], "parameter segment: must be one of 'auto', 'rgb', 'depth', got 'bogus'"),
+    (["-p", "harmonics:=100000"], "parameter harmonics: must be at most 100, got 100000"),
+    (["-p", "xy_step:=1e-9"], "parameter xy_step: the search grid would have"),
     (["-p", "bogus"], "contourgrasp: error: ROS arguments: failed to initialize rcl: Couldn't parse parameter"),
-], ids=["refused-parameter", "unparsable-argument"])
+], ids=["refused-parameter", "too-many-harmonics", "too-fine-a-grid", "unparsable-argument"])
 def test_the_ros_command_exits_2_with_one_line_for_bad_arguments(ros_args, message):
     done = subprocess.run(_ros_command(*ros_args), capture_output=True, text=True, timeout=TIMEOUT)
     assert done.returncode == 2
     assert message in done.stderr and "Traceback" not in done.stderr
+    assert "deprecated" not in done.stderr  # third-party import warnings are not the user's business
 
 
 def test_the_ros_command_serves_plan_and_stops_on_ctrl_c(ros):

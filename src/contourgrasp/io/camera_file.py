@@ -294,6 +294,26 @@ def read_rgbd(rgb_path=None, depth_path=None, intrinsics_path=None, *, mask_path
     return RGBDFrame(rgb=rgb, depth=depth, intrinsics=intrinsics, mask=mask)
 
 
+def read_masked_frames(root):
+    """Every frame with a mask below ``root`` in the Dex-Net layout, in name order: (name, :class:`RGBDFrame`).
+
+    A frame is a folder's ``color_N.png``, ``depth_N.npy`` (meters) and ``segmask_N.png``, with the folder's
+    first ``*.intr`` file (the layout of ``examples/bar_clamp`` and of the GQ-CNN datasets); its name is
+    ``<folder>/N``. A mask without its depth image or a folder without intrinsics is passed over.
+
+    Raises
+    ------
+    InputError
+        A frame's files that cannot be read (naming the file).
+    """
+    for mask_path in sorted(Path(root).glob("*/segmask_*.png")):
+        folder, index = mask_path.parent, mask_path.stem.removeprefix("segmask_")
+        intrinsics = sorted(folder.glob("*.intr"))
+        if intrinsics and (folder / f"depth_{index}.npy").is_file():
+            yield f"{folder.name}/{index}", read_rgbd(folder / f"color_{index}.png", folder / f"depth_{index}.npy",
+                                                      intrinsics[0], mask_path=mask_path)
+
+
 # ---------------------------------------------------------------------------
 # Low-level readers
 # ---------------------------------------------------------------------------
@@ -307,6 +327,7 @@ def _require_file(path: Path) -> None:
 def _read_image(path, flags) -> np.ndarray:
     path = Path(path)
     _require_file(path)
+    _check_image_size(path)
     try:
         data = np.frombuffer(path.read_bytes(), dtype=np.uint8)
     except OSError as err:
@@ -334,8 +355,36 @@ def _quiet_stderr():
         os.close(saved)
 
 
+def _check_image_size(path: Path) -> None:
+    """Refuse an image of more than ``MAX_IMAGE_PIXELS`` from its header, before it is decoded; one Pillow cannot
+    read is left to OpenCV, which refuses what it cannot decode."""
+    from PIL import Image  # matplotlib's dependency: reads the header only
+
+    try:
+        with Image.open(path) as image:
+            width, height = image.size
+    except Exception:  # noqa: BLE001 -- any reason Pillow cannot read a header: OpenCV decides
+        return
+    _check_pixels(path, width, height)
+
+
+def _check_pixels(path: Path, width: int, height: int) -> None:
+    if width * height > tol.MAX_IMAGE_PIXELS:
+        raise InputError(f"{path}: a {width}x{height} image has more than {tol.MAX_IMAGE_PIXELS:,} pixels, "
+                         f"the most contourgrasp reads")
+
+
 def _load_npy(path: Path) -> np.ndarray:
     _require_file(path)
+    try:
+        header = np.load(path, mmap_mode="r", allow_pickle=False)  # the shape, before the data is read
+    except (OSError, ValueError, EOFError) as err:
+        raise InputError(f"{path}: not a readable .npy array ({err})") from None
+    shape = getattr(header, "shape", ())
+    if len(shape) >= 2:
+        _check_pixels(path, shape[1], shape[0])
+    elif math.prod(shape) > tol.MAX_IMAGE_PIXELS:
+        raise InputError(f"{path}: an array of {math.prod(shape):,} values, more than an image contourgrasp reads")
     try:
         data = np.load(path, allow_pickle=False)
     except (OSError, ValueError, EOFError) as err:
@@ -354,22 +403,36 @@ def _read_text(path: Path) -> str:
 
 
 def _read_mapping(path: Path):
+    """A JSON or YAML file's data. YAML aliases are refused (camera data needs none, and a few of them make a
+    file of bytes into an array of gigabytes); so are numbers of more digits than Python reads."""
     text = _read_text(path)
-    if path.suffix.lower() in (".yaml", ".yml"):
-        import yaml  # optional dependency: only YAML files need it
-
-        try:
-            return yaml.safe_load(text)
-        except yaml.YAMLError as err:
-            raise InputError(f"{path}: not valid YAML ({' '.join(str(err).split())})") from None
-        except RecursionError:
-            raise InputError(f"{path}: nested too deeply to be camera data") from None
     try:
+        if path.suffix.lower() in (".yaml", ".yml"):
+            return _read_yaml(path, text)
         return json.loads(text)
+    except InputError:
+        raise
     except json.JSONDecodeError as err:
         raise InputError(f"{path}: not valid JSON ({err})") from None
     except RecursionError:
         raise InputError(f"{path}: nested too deeply to be camera data") from None
+    except ValueError as err:  # an integer of more than sys.get_int_max_str_digits() digits
+        raise InputError(f"{path}: a number too long to be camera data ({str(err).split(';')[0]})") from None
+
+
+def _read_yaml(path: Path, text: str):
+    import yaml
+
+    class NoAliases(yaml.SafeLoader):
+        def compose_node(self, parent, index):
+            if self.check_event(yaml.AliasEvent):
+                raise InputError(f"{path}: YAML aliases (*name) are not camera data; write the values out")
+            return super().compose_node(parent, index)
+
+    try:
+        return yaml.load(text, Loader=NoAliases)  # noqa: S506 -- a SafeLoader
+    except yaml.YAMLError as err:
+        raise InputError(f"{path}: not valid YAML ({' '.join(str(err).split())})") from None
 
 
 def _field(path, data: dict, key: str, name: str | None = None):

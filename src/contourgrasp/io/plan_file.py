@@ -206,6 +206,9 @@ def atomic_outputs(*paths, inputs=()):
     the temporary files, and they are renamed over their targets; if a rename
     fails, the targets already replaced get their old content back. An existing
     output keeps its permissions; a new one gets the usual ``0666 & ~umask``.
+    A symbolic link is followed: its target is replaced and the link kept. An
+    output that exists and is not a regular file (``/dev/null``, ``/dev/stdout``,
+    a FIFO) is written through, after the regular ones, never replaced.
 
     Parameters
     ----------
@@ -230,7 +233,7 @@ def atomic_outputs(*paths, inputs=()):
     >>> (folder / "a.txt").read_text(), none
     ('done', None)
     """
-    targets = [None if p is None else Path(p) for p in paths]
+    targets = [None if p is None else _destination(Path(p)) for p in paths]
     _check_targets(targets, inputs)
     temps = []
     try:
@@ -242,11 +245,34 @@ def atomic_outputs(*paths, inputs=()):
             if str(err.filename) in named:
                 raise OutputError(f"cannot write {named[str(err.filename)]}: {err.strerror}") from None
             raise
-        _replace_all([(t, p) for t, p in zip(temps, targets) if t is not None])
+        _replace_all([(t, p) for t, p in zip(temps, targets) if t is not None and not _is_stream(p)])
+        for tmp, path in zip(temps, targets):
+            if tmp is not None and _is_stream(path):
+                _write_through(tmp, path)
     finally:
         for tmp in temps:
             if tmp is not None and tmp.exists():
                 tmp.unlink()
+
+
+def _destination(path: Path) -> Path:
+    """Where an output goes: the regular file a symbolic link leads to (the link is kept), else the path itself
+    (a link to a device or a pipe, as /dev/stdout is, is written through as it is)."""
+    return path.resolve() if path.is_symlink() and not _is_stream(path) else path
+
+
+def _is_stream(path: Path) -> bool:
+    """An existing output that is not a regular file (a device such as /dev/null, a FIFO, a terminal): written
+    through once every output is ready, never renamed over."""
+    return path.exists() and not path.is_file() and not path.is_dir()
+
+
+def _write_through(tmp: Path, path: Path) -> None:
+    try:
+        with open(tmp, "rb") as source, open(path, "wb") as target:
+            shutil.copyfileobj(source, target)
+    except OSError as err:
+        raise OutputError(f"cannot write {path}: {err.strerror or err}") from None
 
 
 def _check_targets(targets, inputs) -> None:
@@ -263,6 +289,10 @@ def _check_targets(targets, inputs) -> None:
         seen[key] = path
         if path.is_dir():
             raise OutputError(f"{path}: cannot write, it is a directory")
+        if _is_stream(path):
+            if not os.access(path, os.W_OK):
+                raise OutputError(f"{path}: cannot write, no permission")
+            continue
         if not path.parent.is_dir():
             raise OutputError(f"{path}: cannot write, directory {path.parent} does not exist")
         if not os.access(path.parent, os.W_OK | os.X_OK):
@@ -275,8 +305,11 @@ def _key(path: Path) -> str:
 
 
 def _temporary(path: Path) -> Path:
+    """An empty file to write ``path``'s content to: beside it (renamed over it after), or for a stream in the
+    temporary folder (never a new file in /dev)."""
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix,
+                                   dir=None if _is_stream(path) else path.parent)
     except OSError as err:
         raise OutputError(f"cannot write {path}: {err.strerror}") from None
     os.close(fd)

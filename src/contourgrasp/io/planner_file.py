@@ -48,14 +48,16 @@ a grid of at most ``MAX_GRID_POSES`` poses.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Annotated, Literal
+from typing import TYPE_CHECKING, Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from .. import tolerances as tol
 from ..errors import PlannerError, PlannerFileError
-from ..pipeline import PlanOptions
 from ..validation import with_options
+
+if TYPE_CHECKING:
+    from ..pipeline import PlanOptions
 from . import _toml_files
 
 _PRESET_DIR = "data/planners"
@@ -143,6 +145,8 @@ class Planner:
     @classmethod
     def from_settings(cls, name: str, description: str, settings) -> Planner:
         """The planner setting ``settings`` ((flat name, value) pairs) over the defaults; PlannerError naming a bad one."""
+        from ..pipeline import PlanOptions  # the pipeline's import cost only where a planner is loaded
+
         settings = tuple(settings)
         return cls(name, description, settings,
                    with_options(PlanOptions(), dict(settings), what=f"planner {name!r}", error=PlannerError))

@@ -20,7 +20,7 @@ from scipy import ndimage
 
 from .. import validation
 from ..errors import PerceptionError
-from ..tolerances import APPROACH_MEDIAN_PX, MAX_HOLE_PX, SENSOR_RANGE
+from ..tolerances import APPROACH_MEDIAN_PX, FOCAL_RANGE_PX, MAX_HOLE_PX, MAX_IMAGE_PIXELS, SENSOR_RANGE
 from ._frame import memoised
 from ._pixels import even_box, pixel_box, stats_in_image
 
@@ -50,14 +50,29 @@ class Intrinsics:
         for name in ("fx", "fy", "cx", "cy"):
             value = validation.finite(f"intrinsics: {name}", getattr(self, name), error=PerceptionError)
             object.__setattr__(self, name, value)
-        for name in ("fx", "fy"):
-            validation.positive(f"intrinsics: {name}", getattr(self, name), error=PerceptionError)
         for name in ("width", "height"):
             value = getattr(self, name)
             real = not isinstance(value, bool) and isinstance(value, (int, float, np.integer, np.floating))
-            if not (real and math.isfinite(value)) or value != int(value) or value < 1:
-                raise PerceptionError(f"intrinsics: {name} must be a positive whole number of pixels, got {value!r}")
+            try:
+                whole = real and math.isfinite(value) and value == int(value) and value >= 1
+            except OverflowError:
+                whole = False
+            if not whole:
+                raise PerceptionError(f"intrinsics: {name} must be a positive whole number of pixels, "
+                                      f"got {validation.shown(value)}")
             object.__setattr__(self, name, int(value))
+        if self.width * self.height > MAX_IMAGE_PIXELS:
+            raise PerceptionError(f"intrinsics: a {self.width}x{self.height} image has more than "
+                                  f"{MAX_IMAGE_PIXELS:,} pixels, the most contourgrasp plans on")
+        low, high = FOCAL_RANGE_PX
+        for name in ("fx", "fy"):
+            if not low <= getattr(self, name) <= high:
+                raise PerceptionError(f"intrinsics: {name} must be a focal length in pixels in [{low:g}, {high:g}], "
+                                      f"got {getattr(self, name):g}")
+        for name, size in (("cx", self.width), ("cy", self.height)):
+            if not -size <= getattr(self, name) <= 2 * size:
+                raise PerceptionError(f"intrinsics: {name} must lie within the image or one image size beside it, "
+                                      f"[{-size}, {2 * size}] px, got {getattr(self, name):g}")
 
     @property
     def shape(self) -> tuple[int, int]:

@@ -62,6 +62,9 @@ def image_to_array(msg) -> np.ndarray:
     row = width * channels * np.dtype(dtype).itemsize
     if height < 1 or width < 1 or step < row:
         raise InputError(f"{msg.encoding} image {width}x{height}: step {step} is shorter than a row ({row} bytes)")
+    if width * height > tol.MAX_IMAGE_PIXELS:
+        raise InputError(f"{msg.encoding} image {width}x{height}: more than {tol.MAX_IMAGE_PIXELS:,} pixels, the most "
+                         "contourgrasp plans on")
     data = np.frombuffer(memoryview(msg.data), dtype=np.uint8)
     if data.size < step * (height - 1) + row:
         raise InputError(f"{msg.encoding} image {width}x{height}, step {step}: {data.size} bytes, too few")
@@ -174,6 +177,32 @@ def camera_info_fields(intrinsics: Intrinsics) -> dict:
     p = np.c_[k, np.zeros(3)]
     return {"width": intrinsics.width, "height": intrinsics.height, "distortion_model": "plumb_bob",
             "d": np.zeros(5), "k": k.reshape(-1), "r": np.eye(3).reshape(-1), "p": p.reshape(-1)}
+
+
+def header(stamp: float, frame_id: str):
+    """std_msgs/Header at ``stamp`` (s) in ``frame_id`` (the inverse of :func:`stamp_seconds`)."""
+    from builtin_interfaces.msg import Time
+    from std_msgs.msg import Header
+
+    sec = math.floor(stamp)
+    return Header(frame_id=frame_id, stamp=Time(sec=sec, nanosec=round((stamp - sec) * 1e9)))
+
+
+def image_message(pixels, encoding: str, stamp: float, frame_id: str):
+    """sensor_msgs/Image of ``pixels`` (:func:`image_fields`), e.g. to replay a frame to the node."""
+    import array
+
+    from sensor_msgs.msg import Image
+
+    fields = image_fields(pixels, encoding)
+    return Image(header=header(stamp, frame_id), **(fields | {"data": array.array("B", fields["data"])}))
+
+
+def camera_info_message(intrinsics: Intrinsics, stamp: float, frame_id: str):
+    """sensor_msgs/CameraInfo of rectified ``intrinsics`` (:func:`camera_info_fields`)."""
+    from sensor_msgs.msg import CameraInfo
+
+    return CameraInfo(header=header(stamp, frame_id), **camera_info_fields(intrinsics))
 
 
 def pose_stamped(T_camera_hand, header):

@@ -227,6 +227,9 @@ class ContourGraspNode(Node):
         self.camera_info = msg
 
     def _on_pair(self, pair, received: float) -> None:
+        if self.pairer.jumped is not None:
+            self.get_logger().warning(f"the images' stamps went back {self.pairer.jumped:.3f} s (a clock jump?): "
+                                      f"planning on the frame stamped {self.pairer.newest_stamp:.3f} from now on")
         if pair is not None and self.settings.continuous:
             self.plan(pair, received)
 

@@ -1,6 +1,7 @@
 """contourgrasp.sim.bench.journal: trials written as they finish, a killed bench resumed, other settings refused."""
 
 import json
+import re
 import os
 import signal
 import subprocess
@@ -105,3 +106,55 @@ def test_the_scene_is_a_setting_only_when_it_is_not_single():
     assert "scene" not in settings(single)  # journals written before there were scenes resume
     assert settings(Bench(objects=thesis_objects(["can"]), planners=("paper",), trials=1, scene_kind="bin"))["scene"] \
         == "bin"
+
+
+def _journal_with(tmp_path, line: bytes, header: bytes | None = None):
+    """A journal of a one-trial bench whose trial line (or header) is ``line`` (``header``), and that bench."""
+    from contourgrasp.sim.bench import Journal
+
+    bench = Bench(objects=thesis_objects(["can"]), planners=("paper",), trials=2)
+    with Journal.start(tmp_path, bench) as journal:
+        journal.append(BenchTrial("paper", 0, TrialRecord(**RECORD)))
+    lines = (tmp_path / JOURNAL).read_bytes().split(b"\n")
+    (tmp_path / JOURNAL).write_bytes(b"\n".join([header or lines[0], lines[1], line, b""]))
+    return bench
+
+
+def _good_line(**changes) -> bytes:
+    from contourgrasp.sim.bench.report import trial_to_dict
+
+    data = trial_to_dict(BenchTrial("paper", 1, TrialRecord(**RECORD))) | changes
+    return json.dumps(data).encode()
+
+
+@pytest.mark.parametrize("line, says", [
+    (b"{}", "line 3: not a trial of this bench (object: Field required)"),
+    (b"[1, 2]", "line 3: not a trial of this bench"),
+    (b"null", "line 3: not a trial of this bench"),
+    (_good_line(colour="red"), "line 3: not a trial of this bench (colour: Extra inputs are not permitted)"),
+    (_good_line(success="yes"), "line 3: not a trial of this bench (success: Input should be a valid boolean)"),
+    (_good_line(object="case"), "line 3: a trial this bench does not run (paper on case, trial 1)"),
+    (_good_line(planner="default"), "line 3: a trial this bench does not run (default on can, trial 1)"),
+    (_good_line(trial=7), "line 3: a trial this bench does not run (paper on can, trial 7)"),
+    (b'{"object": ' + b"9" * 5000 + b"}", "line 3: not a trial (Exceeds the limit (4300 digits)"),
+    (b"\xff\xfe{\x00}\x00", "not a bench journal (not UTF-8 text"),
+])
+def test_resume_names_the_line_of_a_journal_it_cannot_read(tmp_path, line, says):
+    from contourgrasp.errors import SimulationError
+    from contourgrasp.sim.bench import resume
+
+    bench = _journal_with(tmp_path, line)
+    before = (tmp_path / JOURNAL).read_bytes()
+    with pytest.raises(SimulationError, match=re.escape(says)):
+        resume(tmp_path, bench)
+    assert (tmp_path / JOURNAL).read_bytes() == before
+
+
+def test_resume_names_a_header_of_other_objects_without_a_traceback(tmp_path):
+    from contourgrasp.errors import SimulationError
+    from contourgrasp.sim.bench import resume
+
+    header = json.dumps({"bench": {"objects": [1, 2]}}).encode()
+    bench = _journal_with(tmp_path, _good_line(), header=header)
+    with pytest.raises(SimulationError, match=re.escape("other objects: 1, 2 there, not here; can here, not there")):
+        resume(tmp_path, bench)

@@ -14,16 +14,50 @@ import hashlib
 import json
 import os
 from pathlib import Path
+from typing import Annotated
 
 import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from ...errors import SimulationError
+from ...validation import shown
 from ..planners import synthesis_planner
 from .config import Bench, BenchTrial
 from .report import trial_from_dict, trial_to_dict
 
 #: File name of the journal in the bench's output folder.
 JOURNAL = "trials.jsonl"
+
+
+class _Pose(BaseModel):
+    model_config = ConfigDict(extra="forbid", strict=True)
+    x: float
+    y: float
+    yaw: float
+
+
+class _TrialLine(BaseModel):
+    """The fields and types of a journal's trial line (:func:`~contourgrasp.sim.bench.report.trial_to_dict`)."""
+
+    model_config = ConfigDict(extra="forbid", strict=True)
+    object: str
+    planner: str
+    trial: int = Field(ge=0)
+    seed: int
+    success: bool
+    cause: str | None
+    fingers_in_contact: list[str]
+    first_contact: list[Annotated[tuple[str, float], Field(strict=False)]]  # JSON writes a pair as a list
+    push: float
+    lift: float
+    hold_drift: float
+    approach_depth: float | None
+    grasp_height: float | None = None
+    plan_error: str | None
+    sim_time: float
+    plan_time: float
+    wall_time: float
+    pose: _Pose | None
 
 
 def settings(bench: Bench) -> dict:
@@ -129,14 +163,18 @@ def resume(out, bench: Bench) -> tuple[Journal, tuple[BenchTrial, ...]]:
     path = Path(out) / JOURNAL
     if not path.is_file():
         raise SimulationError(f"{out}: nothing to resume, no {JOURNAL} (run the bench with --out {out} first)")
-    text = path.read_text(encoding="utf-8")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as err:
+        raise SimulationError(f"{path}: not a bench journal (not UTF-8 text: byte {err.start})") from None
     lines = text.split("\n")
     header = _parse(lines[0], path, 1)
     if not isinstance(header, dict) or not isinstance(header.get("bench"), dict):
         raise SimulationError(f"{path}: not a bench journal (its first line holds no bench settings)")
     _same_settings(header["bench"], settings(bench), out)
     complete = lines[1:-1]  # the last piece is '' after a final newline, or a torn line
-    results = [trial_from_dict(_parse(line, path, k + 2)) for k, line in enumerate(complete) if line]
+    results = [_trial(_parse(line, path, k + 2), bench, f"{path}, line {k + 2}")
+               for k, line in enumerate(complete) if line]
     ran = {(r.planner, r.record.object, r.trial) for r in results}
     if len(ran) != len(results):
         raise SimulationError(f"{path}: a trial appears twice")
@@ -149,7 +187,24 @@ def _parse(line: str, path: Path, number: int):
     try:
         return json.loads(line)
     except json.JSONDecodeError as err:
-        raise SimulationError(f"{path}, line {number}: not JSON ({err.msg})") from err
+        raise SimulationError(f"{path}, line {number}: not JSON ({err.msg})") from None
+    except (ValueError, RecursionError) as err:  # a number of more digits than Python reads, nesting too deep
+        raise SimulationError(f"{path}, line {number}: not a trial ({str(err).split(';')[0]})") from None
+
+
+def _trial(data, bench: Bench, where: str) -> BenchTrial:
+    """The trial of a journal line, checked field by field and against the bench resumed (``where`` names the line)."""
+    try:
+        line = _TrialLine.model_validate(data)
+    except ValidationError as err:
+        first = err.errors()[0]
+        field = ".".join(map(str, first["loc"])) or "the line"
+        raise SimulationError(f"{where}: not a trial of this bench ({field}: {first['msg']})") from None
+    if line.planner not in bench.planners or line.object not in {o.name for o in bench.objects} \
+            or line.trial >= bench.trials:
+        raise SimulationError(f"{where}: a trial this bench does not run ({line.planner} on {line.object}, trial "
+                              f"{line.trial}): the journal is another bench's")
+    return trial_from_dict(line.model_dump())
 
 
 def _same_settings(old: dict, new: dict, out) -> None:
@@ -164,10 +219,10 @@ def _difference(key: str, old, new) -> str:
         gone, added = [v for v in old if v not in new], [v for v in new if v not in old]
         if not gone and not added:
             return f"{key}: the same, in another order"
-        said = [f"{', '.join(gone[:3])} there, not here" if gone else "",
-                f"{', '.join(added[:3])} here, not there" if added else ""]
+        said = [f"{', '.join(map(str, gone[:3]))} there, not here" if gone else "",
+                f"{', '.join(map(str, added[:3]))} here, not there" if added else ""]
         return f"{key}: {'; '.join(filter(None, said))}"
-    return f"{key}: {old} there, {new} here"
+    return f"{key}: {shown(old)} there, {shown(new)} here"
 
 
 def _replace(path: Path, rows) -> None:
