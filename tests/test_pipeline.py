@@ -266,6 +266,11 @@ def test_rgb_segmentation_of_the_bundled_frame_is_repaired_not_refused():
     ({"depth_mode": 3}, "depth_mode must be one of"),
     ({"fill_holes": "yes"}, "fill_holes must be True or False"),
     ({"colour_offset_px": (1.5, 0)}, "colour_offset_px must be two integers"),
+    ({"colour_offset_px": (99999, 99999)}, r"colour_offset_px \(99999, 99999\) moves the colour image out of the "
+                                           "640x480 frame"),
+    ({"standoff": 10**400}, "standoff must be a finite number, got 1000"),
+    ({"xy_step": 10**400}, "xy_step must be a finite number, got 1000"),
+    ({"friction": 10**400}, "friction must be a finite number, got 1000"),
     ({"footprint": 1}, "footprint must be True, False or None"),
     ({"T_base_camera": np.full((4, 4), np.nan)}, r"T_base_camera\[0, 0\] is not finite"),
     ({"T_base_camera": np.eye(3)}, r"T_base_camera must be a \(4, 4\) array"),

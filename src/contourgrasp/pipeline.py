@@ -329,6 +329,9 @@ def _perceive(rgb, depth, intrinsics, options: PerceptionOptions, *, mask, targe
     if target_px is not None and roi is not None:
         raise PerceptionError("give target_px or roi, not both")
     shape = (intrinsics.height, intrinsics.width)
+    if options.colour_offset_px is not None and any(abs(o) >= n for o, n in zip(options.colour_offset_px, shape[::-1])):
+        raise PerceptionError(f"colour_offset_px {options.colour_offset_px} moves the colour image out of the "
+                              f"{intrinsics.width}x{intrinsics.height} frame")
     if target_px is not None:
         target_px = perception.candidates.check_pixel(target_px, shape)
     if roi is not None:

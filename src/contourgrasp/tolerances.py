@@ -269,6 +269,9 @@ HOMOGENEOUS_ROW = 1e-9
 # --- sim ---
 
 #: A mesh whose largest extent exceeds this (m) is taken to be in millimetres.
+#: Most triangles of an object's mesh: the YCB meshes have 16,384; a denser one costs minutes a trial in the
+#: convex decomposition and the contacts, and is refused naming the file.
+MESH_MAX_FACES = 100_000
 MESH_MAX_EXTENT = 1.0
 
 #: A mesh whose vertices all lie within this fraction of its size from its convex hull is convex enough
@@ -284,6 +287,10 @@ FINGER_MOVED = 1e-3
 #: Longest closing or hold of a hand model in free air (derive.derive_hand, force.fingertip_forces), s:
 #: a bound on the simulation an argument can ask for (the defaults are 1-3 s).
 MAX_MODEL_CLOSING_TIME = 60.0
+
+#: Most bodies of a MuJoCo hand model read (a hand on an arm has well under a hundred): a larger model is refused
+#: before it is closed, as not a hand.
+MAX_MODEL_BODIES = 300
 
 #: force.fingertip_forces: a fingertip slower than this has no direction of motion to push along
 #: (stopped at a joint limit, say), m/s; a 3 s closing moves the bundled models' tips at 20-40 mm/s.

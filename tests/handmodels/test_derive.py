@@ -203,3 +203,28 @@ def test_the_fit_table_says_which_chains_are_measured():
     assert fit_table(derive_hand("jaco-three-finger"))[-1] == (
         "3-D chains and palm: yes (as measured: thumb, index, pinky, the palm tilted)")
 
+
+
+@pytest.mark.parametrize("options, message", [
+    ({"fingertips": 3}, "fingertips must be a list of names, got 3"),
+    ({"fingertips": "thumb_tip"}, "fingertips must be a list of names, got 'thumb_tip'"),
+    ({"actuators": [1, 2]}, "actuators must be a list of names"),
+    ({"palm": 3}, "palm must be a body's name, got 3"),
+    ({"close_time": 10**400}, "close_time must be a finite number"),
+])
+def test_bad_arguments_are_hand_errors_naming_them(options, message):
+    from contourgrasp.errors import HandError
+
+    with pytest.raises(HandError, match=message):
+        derive_hand("inspire", **options)
+
+
+def test_a_model_of_thousands_of_bodies_is_refused_before_it_is_closed(tmp_path):
+    from contourgrasp.errors import HandFileError
+
+    bodies = "".join(f'<body name="b{i}" pos="{0.01 * i} 0 0"><joint name="j{i}"/><geom size="0.005"/></body>'
+                     for i in range(2000))
+    path = tmp_path / "many.xml"
+    path.write_text(f'<mujoco><worldbody><body name="palm"><geom size="0.01"/>{bodies}</body></worldbody></mujoco>')
+    with pytest.raises(HandFileError, match="many.xml: 2002 bodies, more than a hand model has"):
+        derive_hand(path, fingertips=["b1", "b2"])

@@ -108,11 +108,21 @@ def bag(tmp_path_factory, frame):
     (lambda bag, tmp: ["plan", "--bag", str(bag), "--color-topic", "/c"], "--bag needs --depth-topic, --info-topic"),
     (lambda bag, tmp: [*_bag_args(bag), "--rgb", "x.png"], "--bag replaces --rgb, --depth and --intrinsics"),
     (lambda bag, tmp: ["plan"], "plan needs --depth and --intrinsics, or --bag"),
-], ids=["no-bag", "not-a-bag", "missing-topic", "wrong-type", "index", "topics-missing", "bag-and-files", "no-input"])
+    (lambda bag, tmp: _bag_args(_corrupt_metadata(tmp)), "cannot read the bag: Could not load YAML"),
+], ids=["no-bag", "not-a-bag", "missing-topic", "wrong-type", "index", "topics-missing", "bag-and-files", "no-input",
+        "corrupt-metadata"])
 def test_a_bad_bag_or_option_is_one_line_and_exit_2(bag, tmp_path, capsys, args, message):
     assert main(args(bag, tmp_path)) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and message in err, err
+
+
+def _corrupt_metadata(tmp) -> Path:
+    """A bag folder whose metadata.yaml breaks off inside a list (rosbags' message spans seven lines)."""
+    folder = tmp / "corrupt"
+    folder.mkdir()
+    (folder / "metadata.yaml").write_text("rosbag2_bagfile_information:\n  version: [\n")
+    return folder
 
 
 def _garbage(tmp) -> Path:

@@ -128,3 +128,15 @@ def test_bad_parts_and_objects_are_simulation_errors():
         Part("mesh")
     with pytest.raises(SimulationError, match="mass must be a finite number"):
         ObjectSpec("x", (Part("sphere", (0.01,)),), mass=float("nan"), friction_hand=0.5, friction_table=0.5)
+
+
+def test_a_mesh_of_too_many_triangles_is_refused_before_its_decomposition(tmp_path):
+    import trimesh
+
+    from contourgrasp.tolerances import MESH_MAX_FACES
+
+    sphere = trimesh.creation.icosphere(subdivisions=7, radius=0.04)  # 327,680 triangles
+    assert len(sphere.faces) > MESH_MAX_FACES
+    sphere.export(tmp_path / "dense.stl")
+    with pytest.raises(SimulationError, match="dense.stl: 327,680 triangles, more than 100,000: simplify the mesh"):
+        mesh_object(tmp_path / "dense.stl")

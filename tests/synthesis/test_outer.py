@@ -349,3 +349,16 @@ def test_widening_the_exact_evaluation_evaluates_each_pose_once_and_keeps_the_fu
     np.testing.assert_array_equal(widened.poses, whole.poses)
     np.testing.assert_array_equal(widened.feasible, whole.feasible)
     np.testing.assert_allclose(widened.cost, whole.cost, rtol=0, atol=1e-12)
+
+
+def test_a_failure_leads_with_its_cause_in_one_sentence_then_the_attempts():
+    """The small-object rule, the balance and the fingertips as balls each add an attempt; the message leads with the
+    cause the last of them failed for, and does not repeat it attempt by attempt."""
+    tiny = np.c_[0.005 * np.cos(np.linspace(0, 2 * np.pi, 60, endpoint=False)),
+                 0.0025 * np.sin(np.linspace(0, 2 * np.pi, 60, endpoint=False))]
+    with pytest.raises(NoFeasibleGrasp) as failure:
+        cg.synthesize(tiny, "five-finger-linear", planner="default", yaw_step=0.2)
+    reason = failure.value.reason
+    cause, tried = reason.split(". Tried: ")
+    assert cause == "the object is too small or too far from the hand's grasp region"
+    assert cause not in tried and tried.count("; ") == 3 and "with the fingertips as balls" in tried

@@ -303,9 +303,10 @@ def test_bad_safeguards_are_refused_by_name(option):
 
 def test_a_squeeze_no_screened_pose_balances_is_refused_before_exact_evaluation_then_planned_without():
     lone = one_finger((-0.08, 0.0), (1.0, 0.0), radius=0.0)
-    with pytest.raises(NoFeasibleGrasp, match=r"^none of the \d+ poses that reach the object balances the squeeze.*"
-                                              r"least net force left is 1.00.*; without the squeeze's balance: .*"
-                                              "force closure"):
+    with pytest.raises(NoFeasibleGrasp, match=r"^none of the \d+ poses that reach the object puts its grasp points in "
+                                              r"force closure\. Tried: none of the \d+ poses that reach the object "
+                                              r"balances the squeeze.*least net force left is 1.00.*; without the "
+                                              "squeeze's balance: .*force closure"):
         cg.synthesize(circle(0.03), lone, max_imbalance=0.5, require_closure=True, **FAST)
     plan = cg.synthesize(circle(0.03), lone, max_imbalance=0.5, **FAST)
     assert plan.quality.imbalance == 1.0 and "no pose balances the squeeze" in plan.notes[-1]

@@ -74,6 +74,7 @@ for up to three fingers, all but one beyond.
 from __future__ import annotations
 
 import os
+from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from importlib import resources
 from pathlib import Path
@@ -201,8 +202,12 @@ def model_spec(model, *, fingertips=None, actuators=None, palm=None, approach=No
     HandFileError
         A path without fingertips.
     HandError
-        A ``max_imbalance``, ``grasp_height_fraction`` or ``slice_contour`` the hand would refuse.
+        ``fingertips`` or ``actuators`` not a list of names, ``palm`` not a name; a ``max_imbalance``,
+        ``grasp_height_fraction`` or ``slice_contour`` the hand would refuse.
     """
+    fingertips, actuators = _names("fingertips", fingertips), _names("actuators", actuators)
+    if palm is not None and not isinstance(palm, str):
+        raise HandError(f"palm must be a body's name, got {validation.shown(palm)}")
     if isinstance(model, ModelSpec):
         spec = model
     elif str(model) in MODELS:
@@ -221,6 +226,15 @@ def model_spec(model, *, fingertips=None, actuators=None, palm=None, approach=No
     chosen = {"max_imbalance": max_imbalance, "tips_brush_table": tips_brush_table,
               "grasp_height_fraction": grasp_height_fraction, "slice_contour": slice_contour, "palm": palm}
     return replace(spec, **{k: v for k, v in chosen.items() if v is not None})
+
+
+def _names(what: str, value) -> tuple[str, ...] | None:
+    """``value`` as a tuple of names (None stays None): a list or tuple of strings, not one string."""
+    if value is None:
+        return None
+    if isinstance(value, str) or not isinstance(value, (list, tuple)) or not all(isinstance(v, str) for v in value):
+        raise HandError(f"{what} must be a list of names, got {validation.shown(value)}")
+    return tuple(value)
 
 
 @dataclass(frozen=True)
@@ -469,7 +483,7 @@ class ClosingSimulation:
         for a, value in held:
             d.ctrl[a] = value
         records, joint_records = [], []
-        with mujoco_warnings():
+        with mujoco_warnings(), _fatal_as(source):
             for k in range(settle + ramp + hold + 1):
                 u = min(1.0, max(0.0, (k - settle) / ramp))
                 d.ctrl[acts] = open_ctrl + u * (closed_ctrl - open_ctrl)
@@ -486,6 +500,15 @@ class ClosingSimulation:
         joints = [np.asarray([r[i] for r in joint_records]).reshape(len(records), len(c), 3)
                   for i, c in enumerate(self.chains)]
         return np.transpose(np.asarray(records), (1, 0, 2)), joints, d
+
+
+@contextmanager
+def _fatal_as(source: str):
+    """MuJoCo's own fatal errors (out of its memory arena, ...) as the SimulationError of the model ``source``."""
+    try:
+        yield
+    except mujoco.FatalError as err:
+        raise SimulationError(f"{source}: MuJoCo cannot simulate the model ({' '.join(str(err).split())[:200]})") from None
 
 
 def _axis(name: str, source: str) -> np.ndarray:

@@ -17,6 +17,7 @@ import numpy as np
 os.environ.setdefault("MUJOCO_GL", "disable")
 import mujoco  # noqa: E402
 
+from .. import tolerances as tol  # noqa: E402
 from ..errors import HandFileError  # noqa: E402
 from .fit import BOX_CORNERS  # noqa: E402
 from ..sim.scene import mujoco_warnings  # noqa: E402
@@ -29,10 +30,14 @@ def load_model(path) -> mujoco.MjModel:
         raise HandFileError(f"{path}: no such model file")
     try:
         with mujoco_warnings():
-            return mujoco.MjModel.from_xml_path(str(path))
-    except (ValueError, RuntimeError) as err:
+            m = mujoco.MjModel.from_xml_path(str(path))
+    except (ValueError, RuntimeError, mujoco.FatalError) as err:
         reason = " ".join(str(err).split())[:300]
         raise HandFileError(f"{path}: cannot load the MuJoCo model ({reason})") from None
+    if m.nbody > tol.MAX_MODEL_BODIES:
+        raise HandFileError(f"{path}: {m.nbody} bodies, more than a hand model has (at most {tol.MAX_MODEL_BODIES}): "
+                            "give the hand's own model")
+    return m
 
 
 def palm_body(m, palm: str | None, fingertips, source: str) -> int:

@@ -23,6 +23,7 @@ import numpy as np
 
 from ..sim.tendon_hand import BASE_XML, HAND_BIT, TABLE_BIT, HandDesign, base_servos_xml
 from .derive import Derivation, derive_hand, model_spec
+from .lookup import load_model
 from ..sim.scene import mujoco
 
 #: Prefix of the mounted model's names in the scene.
@@ -136,6 +137,7 @@ class MountedHand:
 
 def _named_geoms(path: str):
     """The model's spec with its geoms named ``geom<i>`` in their order (unique; renamed once mounted)."""
+    load_model(path)  # its checks, naming the file, before the spec is read
     child = mujoco.MjSpec.from_file(path)
     for i, geom in enumerate(child.geoms):
         geom.name = f"geom{i}"

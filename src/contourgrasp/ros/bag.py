@@ -49,7 +49,7 @@ def read_bag_frame(path, color_topic: str, depth_topic: str, info_topic: str, *,
     except (AnyReaderError, OSError, ValueError, KeyError, AssertionError) as err:
         if isinstance(err, InputError):
             raise
-        raise InputError(f"{path}: cannot read the bag: {err}") from None
+        raise InputError(f"{path}: cannot read the bag: {' '.join(str(err).split())[:300]}") from None
     try:
         rgb, d, intrinsics = messages.rgbd_arrays(colour, depth, info)
     except InputError as err:

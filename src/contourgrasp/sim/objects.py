@@ -55,7 +55,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import SimulationError
-from ..tolerances import MESH_CONVEX, MESH_MAX_EXTENT
+from ..tolerances import MESH_CONVEX, MESH_MAX_EXTENT, MESH_MAX_FACES
 from ..validation import choice, finite_array, positive
 
 #: CoACD settings (fast rather than tight: a grasp needs the outline, not every dent).
@@ -258,7 +258,7 @@ def mesh_object(path, *, scale: float = 1.0, mass: float = 0.2, friction_hand: f
         The file cannot be read as a mesh, is empty, has a non-finite vertex,
         encloses no volume (a flat or degenerate mesh), or is larger than
         :data:`~contourgrasp.tolerances.MESH_MAX_EXTENT` (probably millimetres,
-        or a missing ``scale``).
+        or a missing ``scale``), or has more than :data:`~contourgrasp.tolerances.MESH_MAX_FACES` triangles.
     """
     path = Path(path)
     mesh = _load_mesh(path, scale)
@@ -294,6 +294,9 @@ def _read_mesh(path: Path, *, process: bool):
         raise SimulationError(f"{path}: cannot read mesh ({type(err).__name__}: {err})") from None
     if not isinstance(loaded, trimesh.Trimesh) or len(loaded.faces) == 0:
         raise SimulationError(f"{path}: no triangles found in the mesh")
+    if len(loaded.faces) > MESH_MAX_FACES:
+        raise SimulationError(f"{path}: {len(loaded.faces):,} triangles, more than {MESH_MAX_FACES:,}: simplify the mesh "
+                              "(e.g. quadric decimation in MeshLab or Blender)")
     return loaded
 
 

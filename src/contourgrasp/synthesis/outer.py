@@ -157,6 +157,15 @@ def search(
     elsewhere = _Elsewhere(balanced_alternative)
     outline = partial(_search_outline, hand=hand, options=replace(options, safeguards=safeguards), descent=descent,
                       clock=clock, fallback=preferred, alternative=elsewhere)
+    try:
+        return _search_rules(contour, hand, options, outline, elsewhere, low_object)
+    except NoFeasibleGrasp as err:
+        raise NoFeasibleGrasp(_led(err.reason)) from None
+
+
+def _search_rules(contour, hand: Hand, options: SearchOptions, outline, elsewhere: _Elsewhere,
+                  low_object) -> GraspPlan:
+    """:func:`search` on the outline seen, after the low-object rule's pinch; the fingertips as balls last."""
     radius = min(f.radius for f in hand.fingers)
     if check.flag("low_object", low_object, error=PlannerError) and radius > 0:
         pinch = replace(hand, min_touching=_fewest_touching(hand), miss_penalty=0.0)
@@ -177,6 +186,16 @@ def search(
             raise NoFeasibleGrasp(f"{points.reason}; with the fingertips as balls (the outline grown by "
                                   f"{1000 * radius:.1f} mm): {why}") from None
     return plan if plan is elsewhere.plan else _as_balls(plan, contour, radius, NOTE_BALLS)
+
+
+def _led(reason: str) -> str:
+    """A failure's reason led by its cause in one sentence: the last attempt's (the most relaxed search, whose failure
+    is the plan's), then the attempts, each without that cause repeated."""
+    attempts = reason.split("; ")
+    last = attempts[-1] if len(attempts) == 1 else attempts[-1].split(": ", 1)[-1]
+    cause = (last.split("): ", 1)[1] if "): " in last else last).split(" (the same ")[0]
+    tried = reason.replace(f"): {cause}", ")")
+    return cause if tried == cause else f"{cause}. Tried: {tried}"
 
 
 def _grown(contour, radius: float) -> np.ndarray:

@@ -48,6 +48,31 @@ def test_a_killed_bench_resumes_where_it_stopped(serial_bench, tmp_path, capsys)
     assert journal.read_text().count("\n") == 9
 
 
+@pytest.mark.parametrize("workers", ["1", "2"])
+def test_ctrl_c_ends_a_bench_in_one_line_keeping_its_journal(tmp_path, capsys, workers):
+    """Ctrl-C reaches the whole process group (the bench and its workers): exit 130, one line, no traceback, and the
+    journal resumes to the same trials."""
+    out = tmp_path / "out"
+    env = os.environ | {"MPLBACKEND": "Agg"}
+    bench = subprocess.Popen([sys.executable, "-m", "contourgrasp.cli", *SMALL, "--trials", "4", "--workers", workers,
+                              "--out", str(out)], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=env,
+                             start_new_session=True, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    journal = out / JOURNAL
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and bench.poll() is None:
+        if journal.exists() and journal.read_text().count("\n") >= 3:
+            break
+        time.sleep(0.05)
+    os.killpg(bench.pid, signal.SIGINT)
+    _, err = bench.communicate(timeout=120)
+    lines = [line for line in err.splitlines() if not line.startswith("bench:")]  # progress lines
+    assert bench.returncode == 130, err
+    assert lines == [f"contourgrasp: interrupted: the trials finished are kept in {journal}; continue with --resume "
+                     f"{out}"], err
+    assert main([*SMALL, "--trials", "4", "--workers", "1", "--resume", str(out)]) == 0
+    capsys.readouterr()
+
+
 @pytest.mark.parametrize("change, setting", [
     (["--trials", "3"], "other trials: 2 there, 3 here"),
     (["--objects", "can"], "other objects: case there, not here"),

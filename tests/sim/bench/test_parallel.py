@@ -1,5 +1,7 @@
 """contourgrasp.sim.bench.parallel: worker processes and Ray give the serial run's trials; bad settings refused."""
 
+import os
+import subprocess
 import sys
 
 import pytest
@@ -50,6 +52,7 @@ def test_a_local_ray_gives_the_serial_trials(serial_bench, tmp_path):
     (["--ray", "ray://127.0.0.1:1"], "cannot reach Ray at 'ray://127.0.0.1:1' (127.0.0.1:1)"),
     (["--ray", "127.0.0.1:port"], "cannot reach Ray at '127.0.0.1:port'"),
     (["--ray", "ray://:5"], "no host in the address"),
+    (["--ray", "[::1"], "cannot reach Ray at '[::1': Invalid IPv6 URL"),
 ])
 def test_bad_workers_and_unreachable_ray_exit_2_and_write_nothing(argv, message, tmp_path, capsys):
     if "--ray" in argv:
@@ -58,6 +61,56 @@ def test_bad_workers_and_unreachable_ray_exit_2_and_write_nothing(argv, message,
     code, err = run_cli([*SMALL, *argv, "--out", out], capsys)
     assert code == 2 and message in err and len(err.strip().splitlines()) == 1, err
     assert not out.exists()
+
+
+def test_an_address_that_accepts_but_is_not_ray_fails_fast(tmp_path, capsys, monkeypatch):
+    """A server that accepts the connection and says nothing (or speaks HTTP/1): refused in about the timeout, not
+    after Ray's own minutes of retries."""
+    import socket
+    import threading
+    import time
+
+    from contourgrasp.sim.bench import parallel
+
+    pytest.importorskip("ray", reason="ray is not installed")
+    monkeypatch.setattr(parallel, "RAY_CONNECT_TIMEOUT", 1.0)
+    with socket.create_server(("127.0.0.1", 0)) as server:
+        accepted = []
+        threading.Thread(target=lambda: accepted.append(server.accept()), daemon=True).start()
+        out, started = tmp_path / "out", time.monotonic()
+        code, err = run_cli([*SMALL, "--ray", f"127.0.0.1:{server.getsockname()[1]}", "--out", out], capsys)
+        assert code == 2 and "does not answer as Ray does (gRPC)" in err and len(err.strip().splitlines()) == 1, err
+        assert time.monotonic() - started < 10 and not out.exists()
+
+
+def test_more_workers_than_cores_run_as_many_processes_as_cores(serial_bench, tmp_path, capsys):
+    code, err = run_cli([*SMALL, "--workers", "1000", "--out", tmp_path], capsys)
+    assert code == 0 and f"--workers 1000: this machine has {os.cpu_count()} cores" in err
+    assert trials_without_times(tmp_path) == trials_without_times(serial_bench)
+
+
+def test_a_ray_cluster_at_an_address_gives_the_serial_trials(serial_bench, tmp_path):
+    """A real Ray head started by ``ray start`` on a free port, the bench sent to it by address."""
+    import shutil
+    import socket
+
+    pytest.importorskip("ray", reason="ray is not installed")
+    ray_command = shutil.which("ray", path=os.path.dirname(sys.executable))
+    if ray_command is None:
+        pytest.skip("the ray command is not installed beside this Python")
+    with socket.create_server(("127.0.0.1", 0)) as probe:
+        port = probe.getsockname()[1]
+    env = os.environ | {"RAY_USAGE_STATS_ENABLED": "0"}
+    start = [ray_command, "start", "--head", f"--port={port}", "--num-cpus=2", "--include-dashboard=false",
+             "--disable-usage-stats"]
+    subprocess.run(start, check=True, capture_output=True, timeout=180, env=env)
+    try:
+        done = subprocess.run([sys.executable, "-m", "contourgrasp.cli", *SMALL, "--ray", f"127.0.0.1:{port}",
+                               "--out", str(tmp_path)], capture_output=True, text=True, timeout=600, env=env)
+        assert done.returncode == 0, done.stderr[-2000:]
+    finally:
+        subprocess.run([ray_command, "stop", "--force"], capture_output=True, timeout=180, env=env)
+    assert trials_without_times(tmp_path) == trials_without_times(serial_bench)
 
 
 def test_ray_missing_names_the_install_command(tmp_path, capsys, monkeypatch):

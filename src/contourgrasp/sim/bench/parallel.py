@@ -20,11 +20,12 @@ import logging
 import multiprocessing
 import os
 import socket
+import warnings
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
 from urllib.parse import urlsplit
 
-from ...errors import SimulationError
+from ...errors import ContourGraspWarning, SimulationError
 from ...threads import one_blas_thread
 from ...validation import integer
 from .config import Bench, BenchTrial
@@ -163,22 +164,49 @@ def _connect(ray, address: str | None, workers: int) -> bool:
 
 
 def _reachable(address: str) -> None:
-    """Refuse an address whose host does not accept a connection within :data:`RAY_CONNECT_TIMEOUT`."""
+    """Refuse an address whose host does not accept a connection, or does not answer as a gRPC server (Ray's GCS
+    and Ray Client both are), within :data:`RAY_CONNECT_TIMEOUT`: Ray itself would wait minutes on either."""
     if address in ("auto", "local"):
         return
     client = address.startswith("ray://")
-    parts = urlsplit(address if "://" in address else f"//{address}")
     try:
+        parts = urlsplit(address if "://" in address else f"//{address}")
         host, port = parts.hostname, parts.port or (RAY_CLIENT_PORT if client else RAY_GCS_PORT)
-    except ValueError as err:  # a port that is not a number
-        raise SimulationError(f"cannot reach Ray at {address!r}: {err}") from err
+    except ValueError as err:  # a port that is not a number, an unclosed IPv6 bracket
+        raise SimulationError(f"cannot reach Ray at {address!r}: {err}") from None
     if not host:
         raise SimulationError(f"cannot reach Ray at {address!r}: no host in the address")
     try:
-        socket.create_connection((host, port), timeout=RAY_CONNECT_TIMEOUT).close()
+        with socket.create_connection((host, port), timeout=RAY_CONNECT_TIMEOUT) as connection:
+            answer = _http2_answer(connection)
     except OSError as err:
         reason = err.strerror or str(err) or type(err).__name__
-        raise SimulationError(f"cannot reach Ray at {address!r} ({host}:{port}): {reason}") from err
+        raise SimulationError(f"cannot reach Ray at {address!r} ({host}:{port}): {reason}") from None
+    if answer is None:
+        raise SimulationError(f"cannot reach Ray at {address!r} ({host}:{port}): the server there does not answer as "
+                              f"Ray does (gRPC) within {RAY_CONNECT_TIMEOUT:g} s; is it Ray's port "
+                              f"({RAY_GCS_PORT}, or {RAY_CLIENT_PORT} with ray://)?")
+
+
+#: The HTTP/2 connection preface and an empty SETTINGS frame: what a gRPC client sends first.
+HTTP2_PREFACE = b"PRI * HTTP/2.0\r\n\r\nSM\r\n\r\n" + bytes([0, 0, 0, 4, 0, 0, 0, 0, 0])
+HTTP2_SETTINGS = 4
+
+
+def _http2_answer(connection: socket.socket) -> bytes | None:
+    """The first frame header a server sends after the HTTP/2 preface, or None when it sends none, or no SETTINGS."""
+    connection.settimeout(RAY_CONNECT_TIMEOUT)
+    try:
+        connection.sendall(HTTP2_PREFACE)
+        header = b""
+        while len(header) < 9:
+            chunk = connection.recv(9 - len(header))
+            if not chunk:
+                return None
+            header += chunk
+    except socket.timeout:
+        return None
+    return header if header[3] == HTTP2_SETTINGS else None
 
 
 def executor(bench: Bench, *, workers: int | None = None, ray: bool = False, address: str | None = None):
@@ -190,6 +218,10 @@ def executor(bench: Bench, *, workers: int | None = None, ray: bool = False, add
         ``workers`` not an integer >= 1 (default: :func:`cores`).
     """
     workers = cores() if workers is None else integer("workers", workers, 1, error=SimulationError)
+    if workers > cores() and not ray:
+        warnings.warn(ContourGraspWarning(f"--workers {workers}: this machine has {cores()} cores; running "
+                                          f"{cores()} processes"), stacklevel=2)
+        workers = cores()
     if ray:
         return ray_tasks(bench, address, workers=workers)
     if workers == 1 or bench.size == 1:
