@@ -218,7 +218,8 @@ FAST_VALUES = {
     "--curvature": ["paper", "geometric"], "--planner": ["paper", "default"],
     "--hand": ["three-finger", "five-finger-linear"], "--depth-scale": ["0.001", "1e-300", "1e300"],
     "--standoff": ["0", "0.1", "1e300"], "--approach-offset=": ["0.01", "-1e9", "1e300"],
-    "--segment": ["auto", "rgb", "depth"], "--depth-mode": ["max", "plane"], "--colour-offset": ["0,0", "1,-3"],
+    "--segment": ["auto", "rgb", "depth"], "--depth-mode": ["max", "plane"],
+    "--colour-offset": ["0,0", "1,-3", "99999,99999"], "--max-imbalance": ["0.25", "hand", "9" * 400],
 }
 SWITCHES = ["--refine", "--no-refine", "--finger-thickness", "--require-closure", "--no-fill-holes", "--footprint"]
 FILE_OPTIONS = ["--hand", "--planner"]
@@ -233,15 +234,32 @@ def fuzz_files(tmp_path_factory):
         "empty": b"", "random": bytes(range(256)) * 4, "utf16": "x,y\n0,0\n1,0\n0,1\n".encode("utf-16"),
         "json": nested_json.encode(), "yaml": ("a:\n" + "".join(" " * i + "- \n" for i in range(1, 200))).encode(),
         "toml": ("a = " + "[" * 50000 + "]" * 50000 + "\n").encode(),
+        "digits": ('{"fx": ' + "9" * 5000 + ', "fy": 500, "cx": 1, "cy": 1, "width": 2, "height": 2}').encode(),
+        "bomb": ("a: &a [1, 1, 1, 1, 1, 1, 1, 1, 1]\n" + "".join(
+            f"{c}: &{c} [*{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}]\n"
+            for p, c in zip("abcdefgh", "bcdefghi"))).encode(),
+        "bodies": ("<mujoco><worldbody><body name='palm'><geom size='0.01'/>" + "".join(
+            f"<body name='b{i}' pos='{0.01 * i} 0 0'><joint/><geom size='0.005'/></body>" for i in range(2000))
+            + "</body></worldbody></mujoco>").encode(),
+        "dense": _dense_png(),
     }
     files = []
     for stem, data in contents.items():
-        for suffix in (".csv", ".npy", ".toml", ".json", ".yaml", ".png", ".obj"):
+        for suffix in (".csv", ".npy", ".toml", ".json", ".yaml", ".png", ".obj", ".xml"):
             path = folder / f"{stem}{suffix}"
             path.write_bytes(data)
             files.append(str(path))
     (folder / "adir").mkdir()
+    (folder / "journal").mkdir()
+    (folder / "journal" / "trials.jsonl").write_bytes(b'{"bench": {"objects": [1, 2]}}\n{}\n[1, 2]\n\xff\xfe\n')
     return folder, files
+
+
+def _dense_png() -> bytes:
+    """A 6000 x 5000 image (30 MP, above the pixels read) in a few kB of PNG."""
+    import cv2
+
+    return cv2.imencode(".png", np.zeros((6000, 5000), np.uint8))[1].tobytes()
 
 
 def _value(option):
@@ -251,15 +269,20 @@ def _value(option):
 @st.composite
 def argv_strategy(draw, files, folder):
     command = draw(st.sampled_from(["synth", "synth", "efd", "plan", "hands", "bench", "calibrate", "hand-from-model"]))
-    any_file = st.sampled_from(files + ["example:can", "example:nope", str(folder / "missing.csv")])
+    any_file = st.sampled_from(files + ["example:can", "example:nope", str(folder / "missing.csv"), "x" * 300])
     argv = [command]
     if command in ("synth", "efd"):
         argv += ["--contour", draw(st.sampled_from(["example:can", "example:stone2"]) | any_file)]
     if command == "plan":
         for option in IMAGE_OPTIONS[:3] + draw(st.lists(st.sampled_from(IMAGE_OPTIONS[3:]), max_size=2)):
             argv += [option, draw(any_file)]
-    if command == "bench":  # never runs a trial: a malformed mesh or an unknown planner stops it first
+    if command == "bench":  # never runs a trial: a malformed mesh, an unknown planner or a bad journal stops it first
         argv += ["--mesh", draw(any_file), "--planners", draw(st.sampled_from(["nope", ""])), "--trials", "1"]
+        argv += draw(st.sampled_from([[], ["--workers", "1000"], ["--ray", "[::1"], ["--ray", "ray://:5"],
+                                      ["--resume", str(folder)], ["--resume", str(folder / "journal")]]))
+    if command == "plan" and draw(st.booleans()):  # a bag instead of the files
+        argv = ["plan", "--bag", draw(any_file | st.just(str(folder))), "--color-topic", "/c", "--depth-topic", "/d",
+                "--info-topic", "/i", "--bag-index", draw(st.sampled_from(["0", "9" * 30]))]
     if command == "calibrate":  # never simulates: every hand here is malformed or refused
         argv += ["--hand", draw(any_file | st.just("five-finger-curved-thumb"))]
     if command == "hand-from-model":  # never simulates: every model here is malformed or missing

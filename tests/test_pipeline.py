@@ -10,6 +10,8 @@ import pytest
 
 import contourgrasp as cg
 from contourgrasp import pipeline
+from contourgrasp.pipeline import PlanOptions
+from contourgrasp.validation import flat_options
 from contourgrasp import tolerances as tol
 from contourgrasp.cli import main
 from contourgrasp.io.camera_file import read_extrinsics, read_intrinsics, read_mask, read_rgbd
@@ -549,3 +551,23 @@ def test_bad_3d_options_are_refused_by_name_even_for_a_2d_hand(standing_can_fram
     rgb, depth, K = standing_can_frame
     with pytest.raises(cg.errors.PlannerError, match=message):
         cg.plan_grasp(rgb, depth, K, cg.load_hand("five-finger-curved-thumb"), yaw_step=0.3, **options)
+
+
+@pytest.mark.parametrize("name", sorted(flat_options(PlanOptions())))
+def test_an_integer_beyond_floats_range_is_an_input_error_for_every_option(name):
+    """10**400 for every option of plan_grasp (and of synthesize, where the search has it): refused by name."""
+    frame = bundled()
+    with pytest.raises(cg.InputError, match=name):
+        cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, "three-finger", **{name: 10**400})
+    if name in flat_options(cg.synthesis.SearchOptions()):
+        with pytest.raises(cg.InputError, match=name):
+            cg.synthesize(cg.example_contour("can"), "three-finger", **{name: 10**400})
+
+
+@pytest.mark.parametrize("name", ["fx", "fy", "cx", "cy", "width", "height"])
+def test_an_integer_beyond_floats_range_is_an_input_error_for_intrinsics(name):
+    from contourgrasp.perception import Intrinsics
+
+    fields = {"fx": 525.0, "fy": 525.0, "cx": 319.5, "cy": 239.5, "width": 640, "height": 480} | {name: 10**400}
+    with pytest.raises(cg.InputError, match=name):
+        Intrinsics(**fields)

@@ -7,6 +7,7 @@ stderr; output files are written atomically (all of them or none).
 from __future__ import annotations
 
 import argparse
+import errno
 import json
 import math
 import sys
@@ -23,7 +24,7 @@ from .io.contour_file import example_contour, example_names, read_contour
 from .io.hand_file import load_hand, preset_names
 from .io.planner_file import load_planner, planner_names
 from .io.plan_file import atomic_outputs, plan_to_dict, write_json
-from .validation import with_options
+from .validation import shown, with_options
 
 EXIT_OK, EXIT_INPUT, EXIT_INFEASIBLE = 0, 2, 3
 #: The palm axes hand-from-model and bench --hand-model accept as the approach, "level"
@@ -672,14 +673,21 @@ def main(argv=None) -> int:
         except KeyboardInterrupt:
             code, message = EXIT_INTERRUPTED, "interrupted" + _kept(args)
         except OSError as err:
-            what = f"cannot write {err.filename}" if err.filename else "cannot write the output"
-            code, message = EXIT_INPUT, f"error: {what}: {err.strerror or err}"
+            code, message = EXIT_INPUT, f"error: {_os_error(err)}"
     for w in caught:
         if issubclass(w.category, ContourGraspWarning):
             print(f"contourgrasp: warning: {w.message}", file=sys.stderr)
     if message:
         print(f"contourgrasp: {message}", file=sys.stderr)
     return code
+
+
+def _os_error(err: OSError) -> str:
+    """An OSError's line: a name too long for a path, or an output that cannot be written."""
+    if err.errno == errno.ENAMETOOLONG:
+        return f"{shown(str(err.filename))}: the file name is too long for this system"
+    what = f"cannot write {err.filename}" if err.filename else "cannot write the output"
+    return f"{what}: {err.strerror or err}"
 
 
 def _kept(args) -> str:

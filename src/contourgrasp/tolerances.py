@@ -262,6 +262,9 @@ MAX_STANDOFF = 2.0
 #: ``.tf`` files, is off by up to about 1.5e-6 (the shared primesense.tf by 1.02e-6).
 ROTATION_TOLERANCE = 1e-5
 
+#: Largest deviation of a unit vector's length from 1 (a plane's normal given by a user), as for rotations.
+UNIT_TOLERANCE = ROTATION_TOLERANCE
+
 #: Largest deviation of a rigid transform's last row from 0 0 0 1.
 HOMOGENEOUS_ROW = 1e-9
 

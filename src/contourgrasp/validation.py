@@ -130,7 +130,7 @@ def finite_array(name: str, value, shape: tuple[int | None, ...] | None = None, 
     array = float_array(name, value, error=error)
     if shape is not None and (array.ndim != len(shape)
                               or any(n is not None and n != m for n, m in zip(shape, array.shape))):
-        wanted = "(" + ", ".join("n" if n is None else str(n) for n in shape) + ")"
+        wanted = "(" + ", ".join("n" if n is None else str(n) for n in shape) + ("," if len(shape) == 1 else "") + ")"
         raise error(f"{name} must be a {wanted} array, got shape {array.shape}")
     bad = ~np.isfinite(array)
     if bad.any():

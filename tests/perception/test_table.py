@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from contourgrasp.perception import SegmentationError, fit_plane, fit_table_plane
+from contourgrasp.perception import PerceptionError, Plane, SegmentationError, fit_plane, fit_table_plane
 from perception_scenes import H, W, CAMERA, render
 
 
@@ -65,3 +65,16 @@ def test_no_table_plane_in_noise():
     with pytest.raises(SegmentationError, match="no table plane") as err:
         fit_table_plane(depth, CAMERA)
     assert err.value.kind == "no-plane"
+
+
+@pytest.mark.parametrize("fields, message", [
+    ({"normal": np.array([np.nan, 0.0, -1.0]), "offset": 0.5}, r"plane: normal\[0\] is not finite"),
+    ({"normal": np.zeros(3), "offset": 0.5}, "plane: normal must be a unit vector, got length 0"),
+    ({"normal": "up", "offset": 0.5}, "plane: normal must be an array of real numbers"),
+    ({"normal": np.array([0.0, 0.0, -1.0, 0.0]), "offset": 0.5}, r"plane: normal must be a \(3,\) array"),
+    ({"normal": np.array([0.0, 0.0, -1.0]), "offset": 10**400}, "plane: offset must be a finite number"),
+    ({"normal": np.array([0.0, 0.0, -1.0]), "offset": 0.5, "inliers": np.zeros(3)}, "plane: inliers must be a bool"),
+])
+def test_a_malformed_plane_is_refused_where_it_is_made(fields, message):
+    with pytest.raises(PerceptionError, match=message):
+        Plane(**fields)

@@ -397,3 +397,29 @@ def test_the_target_parameter_picks_the_object_and_may_be_set_while_running(ros,
         assert camera.call().success
     finally:
         _stopped(ros, node, camera)
+
+
+def test_fuzz_the_parameters_give_settings_or_one_input_error():
+    """Every parameter at absurd values of its own type (what ROS lets through): a Settings, or an InputError naming
+    the parameter; never another exception."""
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
+    from contourgrasp.ros.node import PARAMETERS, settings_from_parameters
+
+    absurd = {bool: st.booleans(), str: st.sampled_from(["", "bogus", "default", "paper", "three-finger", "max", "x" * 500]),
+              int: st.sampled_from([-1, 0, 1, 3, 100, 100000, 10**18]),
+              float: st.sampled_from([0.0, -0.1, 1e-9, 1e-300, 0.02, 1.0, 1e300, float("nan"), float("inf")]),
+              list: st.sampled_from([[-1, -1], [1, 2], [1, 2, 3], [10**9, 1], []])}
+    values = st.fixed_dictionaries({}, optional={name: absurd[type(default)]
+                                                 for name, (default, _) in PARAMETERS.items()})
+
+    @settings(max_examples=150, deadline=None)
+    @given(values)
+    def check(chosen):
+        try:
+            settings_from_parameters(chosen)
+        except InputError as err:
+            assert str(err).startswith("parameter ") and "\n" not in str(err)
+
+    check()

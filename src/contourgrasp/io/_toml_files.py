@@ -6,6 +6,8 @@ import tomllib
 from importlib import resources
 from pathlib import Path
 
+from ..validation import shown
+
 
 def preset_names(folder: str) -> list[str]:
     """Names of the ``*.toml`` presets in the package folder ``folder``, sorted."""
@@ -23,14 +25,18 @@ def read_spec(spec: str, folder: str, *, kind: str, error: type[Exception]) -> t
         return resources.files("contourgrasp").joinpath(f"{folder}/{spec}.toml").read_text(encoding="utf-8"), \
             f"{kind} preset {spec}"
     path = Path(spec)
-    if not path.suffix and not path.exists():
-        raise error(f"unknown {kind} {spec!r}: not a preset ({', '.join(names)}) nor a file")
+    try:
+        missing = not path.exists()
+    except OSError:  # a name too long to be a path: no file
+        missing = True
+    if not path.suffix and missing:
+        raise error(f"unknown {kind} {shown(spec)}: not a preset ({', '.join(names)}) nor a file")
     try:
         return path.read_text(encoding="utf-8"), str(path)
     except UnicodeDecodeError as err:
         raise error(f"{path}: cannot read {kind} file (not UTF-8 text: byte {err.start} is 0x{err.object[err.start]:02x})") from None
     except OSError as err:
-        raise error(f"{path}: cannot read {kind} file ({err.strerror or err})") from None
+        raise error(f"{shown(str(path))}: cannot read {kind} file ({err.strerror or err})") from None
 
 
 def flag_or_word(value, words: tuple[str, ...]):

@@ -15,7 +15,7 @@ import numpy as np
 
 from .. import validation
 from ..errors import PerceptionError, SegmentationError
-from ..tolerances import (MAX_TABLE_TILT, MIN_FLAT_HEIGHT, MIN_PLANE_FRACTION, PLANE_ITERATIONS, PLANE_SAMPLE,
+from ..tolerances import (MAX_TABLE_TILT, UNIT_TOLERANCE, MIN_FLAT_HEIGHT, MIN_PLANE_FRACTION, PLANE_ITERATIONS, PLANE_SAMPLE,
                           PLANE_STRIDE, PLANE_THRESHOLD, SENSOR_RANGE)
 from ._frame import memoised
 from .camera import Intrinsics, as_depth, check_intrinsics, pixel_points, valid_depth
@@ -39,6 +39,17 @@ class Plane:
     normal: np.ndarray
     offset: float
     inliers: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+
+    def __post_init__(self):
+        normal = validation.finite_array("plane: normal", self.normal, (3,), error=PerceptionError)
+        if abs(float(np.linalg.norm(normal)) - 1.0) > UNIT_TOLERANCE:
+            raise PerceptionError(f"plane: normal must be a unit vector, got length {np.linalg.norm(normal):.6g}")
+        object.__setattr__(self, "normal", normal)
+        object.__setattr__(self, "offset", validation.finite("plane: offset", self.offset, error=PerceptionError))
+        inliers = np.asarray(self.inliers)
+        if inliers.dtype != bool:
+            raise PerceptionError(f"plane: inliers must be a bool array, got dtype {inliers.dtype}")
+        object.__setattr__(self, "inliers", inliers)
 
     @property
     def tilt(self) -> float:

@@ -183,3 +183,38 @@ def test_resume_names_a_header_of_other_objects_without_a_traceback(tmp_path):
     bench = _journal_with(tmp_path, _good_line(), header=header)
     with pytest.raises(SimulationError, match=re.escape("other objects: 1, 2 there, not here; can here, not there")):
         resume(tmp_path, bench)
+
+
+def test_fuzz_resume_reads_a_journal_or_names_its_line(tmp_path_factory):
+    """Random trial lines (JSON values, records with a field changed to an absurd value, bytes): resume gives trials
+    or a SimulationError naming the journal; nothing else, and the journal is never changed."""
+    from hypothesis import HealthCheck, given, settings
+    from hypothesis import strategies as st
+
+    from contourgrasp.errors import SimulationError
+    from contourgrasp.sim.bench import resume
+    from contourgrasp.sim.bench.report import trial_to_dict
+
+    good = trial_to_dict(BenchTrial("paper", 1, TrialRecord(**RECORD)))
+    absurd = st.sampled_from([None, True, -1, 10**30, 1e308, float("nan"), "", "x" * 300, [], {}, [1, "a"], {"x": 1}])
+    changed = st.builds(lambda key, value: json.dumps(good | {key: value}).encode(), st.sampled_from(sorted(good)), absurd)
+    values = st.recursive(st.none() | st.booleans() | st.integers() | st.floats() | st.text(max_size=5),
+                          lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=3), inner, max_size=3),
+                          max_leaves=8).map(lambda v: json.dumps(v).encode())
+    lines = changed | values | st.binary(max_size=40)
+
+    @settings(max_examples=150, deadline=None, suppress_health_check=list(HealthCheck))
+    @given(line=lines)
+    def check(line):
+        folder = tmp_path_factory.mktemp("journal")
+        bench = _journal_with(folder, line.replace(b"\n", b" "))
+        before = (folder / JOURNAL).read_bytes()
+        try:
+            journal, trials = resume(folder, bench)
+            journal.close()
+            assert len(trials) == (2 if line.strip() else 1)  # a blank line is no trial
+        except SimulationError as err:
+            assert str(err).startswith(str(folder / JOURNAL)) and "\n" not in str(err)
+            assert (folder / JOURNAL).read_bytes() == before
+
+    check()
