@@ -27,8 +27,8 @@ bench: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/contourgrasp bench --objects can,case,bottle,stone1,stone2 --trials 20 \
 		--planners paper,default,centroid-principal-axis,random --ablation --out bench-output
 
-# The YCB object set (issue 15): the fixed train and test splits, 10 trials per object, on every core,
-# with the 3-D hand's ablation (issue 16): the 2-D planner, + finger bodies, + grasp height, = default.
+# The YCB object set: the fixed train and test splits, 10 trials per object, on every core,
+# with the 3-D hand's ablation: the 2-D planner, + finger bodies, + grasp height, = default.
 bench-ycb: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/contourgrasp bench --objects ycb-train,ycb-test --trials 10 \
 		--planners paper,paper+grid+quality,paper+grid+quality+bodies,paper+grid+quality+bodies+height,paper+grid+quality+bodies+height+small+closing,paper+grid+quality+bodies+height+small+closing+balance,default,centroid-principal-axis,random \

@@ -325,7 +325,7 @@ def test_fuzz_the_command_line_never_tracebacks(fuzz_files):
     assert {p: Path(p).read_bytes() for p in files} == before  # no input was ever overwritten
 
 
-# --- hand-from-model (issue 19) ---
+# --- hand-from-model ---
 
 @pytest.mark.parametrize("model", ["inspire", "jaco-three-finger"])
 def test_hand_from_model_writes_a_hand_that_plans(tmp_path, capsys, model):

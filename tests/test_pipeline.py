@@ -112,7 +112,7 @@ def test_plan_json_has_the_pose_fields(tmp_path, capsys):
 
 
 def test_the_height_map_lines_up_with_the_plan():
-    # Issue 16: the height map is in the planning frame of the plan, around the object by the hand's reach.
+    # the height map is in the planning frame of the plan, around the object by the hand's reach.
     frame = bundled()
     result = cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, "five-finger-linear", **FAST)
     hm = result.height_map

@@ -52,7 +52,7 @@ def test_image_plan_is_drawn_where_the_colour_image_shows_the_object():
 
 @pytest.mark.parametrize("size, label", [(2e-4, "50 µm"), (0.12, "2 cm"), (9000.0, "2000 m")])
 def test_harmonics_figure_draws_any_contour_the_model_accepts(tmp_path, size, label):
-    # Issue 14: a contour x 1e307 crashed matplotlib; the bounds of clean_polygon now refuse it, and the scale
+    # a contour x 1e307 would crash matplotlib; the bounds of clean_polygon refuse it, and the scale
     # bar follows the contour's size, so every accepted contour draws.
     can = cg.example_contour("can")
     fig = visualize.harmonics_figure(can / np.ptp(can, axis=0).max() * size, (1, 4))

@@ -1,4 +1,4 @@
-"""Write the simulated hand's present geometry into the ray presets' hand files (issue 16, item 1.1).
+"""Write the simulated hand's present geometry into the ray presets' hand files.
 
 Each preset's 2-D fingers are given chains and a palm by
 ``contourgrasp.sim.tendon_hand.derive_body`` with the default ``ChainRule`` -- exactly what

@@ -10,7 +10,7 @@ the polygon with the thesis's 4-harmonic EFD (left), with the adaptive one
 and the rule's left-out RMS distance e(N) against N with the tolerance (right).
 This is Figures 4.5/4.6 of the thesis, answered per object.
 
-Sweep (the tables in ``benchmarks/harmonics_sweep.md``)::
+Sweep (its tables chose the tolerance; ``docs/studies.md`` has the reading)::
 
     python tools/harmonics_figure.py --sweep [--sim]
 

@@ -30,7 +30,8 @@ _LAZY = {
     "Arc": (".hand", "Arc"), "Finger": (".hand", "Finger"), "Hand": (".hand", "Hand"), "Ray": (".hand", "Ray"),
     "FingerChain": (".hand", "FingerChain"), "Palm": (".hand", "Palm"), "SampledChain": (".hand", "SampledChain"),
     "example_contour": (".io.contour_file", "example_contour"), "example_names": (".io.contour_file", "example_names"),
-    "read_contour": (".io.contour_file", "read_contour"), "load_hand": (".io.hand_file", "load_hand"),
+    "read_contour": (".io.contour_file", "read_contour"), "read_rgbd": (".io.camera_file", "read_rgbd"),
+    "load_hand": (".io.hand_file", "load_hand"),
     "preset_names": (".io.hand_file", "preset_names"), "load_planner": (".io.planner_file", "load_planner"),
     "planner_names": (".io.planner_file", "planner_names"),
 }
@@ -126,6 +127,6 @@ def plan_grasp(rgb, depth, intrinsics, hand="five-finger-linear", *, planner=Non
 __all__ = [
     "Arc", "ContourError", "EFD", "Finger", "FingerChain", "GraspPlan", "Hand", "HandFileError", "InputError",
     "NoFeasibleGrasp", "Palm", "Ray", "SampledChain", "UnitWarning", "contour", "example_contour", "example_names", "hand",
-    "load_hand", "load_planner", "plan_grasp", "planner_names", "preset_names", "read_contour", "synthesis",
+    "load_hand", "load_planner", "plan_grasp", "planner_names", "preset_names", "read_contour", "read_rgbd", "synthesis",
     "synthesize",
 ]

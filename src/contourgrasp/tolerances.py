@@ -61,12 +61,12 @@ WRENCH_PLANE = 1e-12
 #: A contact normal shorter than this has no direction.
 MIN_NORMAL = 1e-12
 
-#: Adaptive harmonics (efd.choose_harmonics): the fewest and most harmonics it may choose.
+#: Adaptive harmonics (contour.choose_harmonics): the fewest and most harmonics it may choose.
 #: With 1-2 harmonics the thesis's objects have no concave stretch (thesis 4.2.1, Figure 4.5 a-b).
 HARMONICS_BOUNDS = (3, 12)
 
 #: Default of the "rms" rule: RMS distance to the upper-bound model, as a fraction of sqrt(area).
-#: Chosen by `python tools/harmonics_figure.py --sweep --sim` (benchmarks/harmonics_sweep.md).
+#: Chosen by `python tools/harmonics_figure.py --sweep --sim` (docs/studies.md).
 HARMONICS_RMS_TOLERANCE = 0.008
 
 #: Default of the "power" rule: share of the first harmonics' power the model may leave out.
@@ -109,7 +109,7 @@ TILT_PLANE_THRESHOLD = _radians(2.0)
 #: Above this tilt (rad) a warning says the top-down assumption is stretched.
 TILT_WARN = _radians(20.0)
 
-# The support surface (perception.support, issue 17): a table or a bin's floor.
+# The support surface (perception.support): a table or a bin's floor.
 #: Planes considered, the dominant one included.
 SUPPORT_PLANES = 3
 #: A further plane holds at least this fraction of the valid depth pixels.
@@ -408,7 +408,7 @@ MAX_PLAUSIBLE_DEPTH = 20.0
 #: A median depth below this (m) is closer than any depth camera measures.
 MIN_PLAUSIBLE_DEPTH = 0.02
 
-# --- the 3-D hand in the search (issue 16) ---
+# --- the 3-D hand in the search ---
 
 #: Descent check in the search: the clearance (m) every body of the open hand keeps over the height map.
 #: 3 mm covers the map's discretisation (a body moved by half a 2 mm cell's diagonal, 1.4 mm) and the
@@ -429,7 +429,7 @@ GRASP_PALM_CLEARANCE = 0.02
 
 #: Grasp height rule "auto": the grasp height asked for, and the highest accepted where the hand's bodies need
 #: it higher, as fractions of the object's height. Chosen on ycb-train and the thesis's five
-#: (benchmarks/hand3d_sweep.md).
+#: (docs/studies.md).
 GRASP_HEIGHT_FRACTION = 0.4
 MAX_GRASP_HEIGHT_FRACTION = 0.7
 
@@ -443,7 +443,7 @@ MIN_SECTION_CELLS = 50
 IMBALANCE_SCREEN = 0.05
 
 #: A hand's own max_imbalance (Hand.max_imbalance, the planner option's "hand") when its file states none. Chosen
-#: on the five-finger hand's ycb-train and thesis's-five trials (benchmarks/balance_sweep.md); on the three-finger
+#: on the five-finger hand's ycb-train and thesis's-five trials (docs/studies.md); on the three-finger
 #: preset's it ties with 1/3.
 HAND_MAX_IMBALANCE = 0.25
 
@@ -456,7 +456,7 @@ SMALL_OBJECT_TOUCHING = 2
 #: than this (m) is planned first as a pinch with the fingertips as balls (synthesis.search(low_object=True)). Chosen
 #: on ycb-train, in the gap between its objects' heights: the rule lifted the medium clamp (27 mm) and the Lego brick
 #: (24 mm); the next, the gelatin box and the tuna can (32-35 mm), were lifted every time without it (at 36 mm
-#: ycb-train is the same, at 25 mm the clamp leaves the rule and two trials are lost: benchmarks/hand3d_sweep.md).
+#: ycb-train is the same, at 25 mm the clamp leaves the rule and two trials are lost: docs/studies.md).
 LOW_OBJECT_HEIGHT = 0.03
 
 #: Chords per quarter circle of the arcs contour.grow_polygon puts at convex corners (shapely's quad_segs): a 9 mm
@@ -482,7 +482,7 @@ VERTICAL_AXIS = 1e-12
 #: Largest distance (m) of a MuJoCo model's fingertip path, projected on the palm plane, from the ray or
 #: elliptic arc fitted to it; a finger fitting neither within this is refused by hand-from-model.
 MODEL_FIT_TOLERANCE = 3e-3
-# --- simulated scenes of several objects (issue 17) ---
+# --- simulated scenes of several objects ---
 
 #: A neighbour whose centre of mass rose more than this (m) during a grasp was lifted with the target.
 NEIGHBOUR_LIFT = 0.02

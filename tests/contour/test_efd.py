@@ -135,7 +135,7 @@ def test_bad_harmonics_and_mode():
 
 
 
-# --- bad options (issue 14) --------------------------------------------------------------------------
+# --- bad options --------------------------------------------------------------------------
 
 @pytest.mark.parametrize("harmonics, message", [
     (0, "harmonics must be an integer >= 1"),

@@ -62,7 +62,7 @@ def test_first_self_intersection_matches_the_full_pairwise_test(n, seed):
     assert contour.first_self_intersection(points) == (pairs[0] if pairs else None)
 
 
-# --- size bounds: overflow, tiny contours (issue 14) -----------------------------------------------
+# --- size bounds: overflow, tiny contours -----------------------------------------------
 
 @pytest.mark.parametrize("scale", [1e5, 1e155, 1e200, 1e307, 1e308])
 def test_a_contour_beyond_the_size_bound_is_refused(scale):

@@ -49,7 +49,7 @@ def test_a_hanging_finger_points_straight_down_and_a_right_angle_points_along_it
 
 
 def test_lean_geometry_knuckle_inward_of_the_open_tip_by_l_sin_tilt():
-    # The diagnosis: an open finger leaning outward by tilt has its knuckle (l1 + l2) sin(tilt)
+    # The diagnosis: an open finger leaning outward by tilt has its knuckle (l1 + l2) sin(tilt)
     # inward of its tip, i.e. along the closing direction; the tip is (l1 + l2) cos(tilt) below the knuckle.
     for tilt in (math.radians(18.0), math.radians(24.6)):
         chain = straight_chain(tilt=tilt, q=(0.0, 0.0))

@@ -54,7 +54,7 @@ def test_bad_npy_and_missing(tmp_path):
         example_contour("banana")
 
 
-# --- issue 14: malformed files ------------------------------------------------------------------------
+# --- malformed files ------------------------------------------------------------------------
 
 def test_an_empty_npy_is_an_input_error(tmp_path):
     (tmp_path / "empty.npy").write_bytes(b"")

@@ -136,7 +136,7 @@ needs_data = pytest.mark.skipif(
 FOOTPRINTS = {0: (0.063, 0.19), 2: (0.066, 0.14), 4: (0.068, 0.085), 8: (0.074, 0.106)}
 
 
-#: Issue 3's floor: no frame below this IoU with the default method.
+#: The floor: no frame below this IoU with the default method.
 TARGET_WORST_IOU = 0.75
 
 

@@ -1,4 +1,4 @@
-"""Candidates standing on the table and the choice of target (issue 17), on synthetic frames and the bundled one."""
+"""Candidates standing on the table and the choice of target, on synthetic frames and the bundled one."""
 
 from __future__ import annotations
 
@@ -202,8 +202,8 @@ def test_the_bundled_frame_lists_the_grippers_fingers_as_candidates_not_in_view(
     np.testing.assert_allclose(clicked.T_camera_hand, result.T_camera_hand)
 
 
-#: ``contourgrasp plan`` on examples/bar_clamp with the default hand and planner, on main before issue 17 (the
-#: squeeze's balance, which came later, is turned off to compare).
+#: ``contourgrasp plan`` on examples/bar_clamp with the default hand and planner, as the largest region's plan (the
+#: squeeze's balance turned off to compare): listing the candidates must not move it.
 MAIN_POSE = {"x": -0.12883457293878184, "y": -0.018931441854729582, "yaw": 4.60766922526503}
 
 

@@ -1,4 +1,4 @@
-"""The height map (issue 16, item 1.2) against analytic truth: ray-cast boxes and cylinders, top-down and tilted."""
+"""The height map against analytic truth: ray-cast boxes and cylinders, top-down and tilted."""
 
 from __future__ import annotations
 

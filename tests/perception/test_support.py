@@ -1,4 +1,4 @@
-"""The support surface (issue 17): a bin's floor under the objects, not the conveyor with most pixels."""
+"""The support surface: a bin's floor under the objects, not the conveyor with most pixels."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The descent check against MuJoCo's own collision test of the open hand (issue 16: the simulation as oracle).
+"""The descent check against MuJoCo's own collision test of the open hand (the simulation as oracle).
 
 A standing can is rendered and planned on as a user's frame would be; on 240 sampled poses and grasp
 heights the height-map check (what the planner sees, through the noiseless camera) is compared with
@@ -7,7 +7,7 @@ never call a pose clear that MuJoCo finds touching; it may call a clear pose blo
 camera could not see (the can's occlusion shadow is bounded conservatively), but rarely, and it
 refuses a hand over cells outside the camera's view.
 
-The same for the hand models (issue 19), whose bodies the planner knows from ``hand-from-model``:
+The same for the hand models, whose bodies the planner knows from ``hand-from-model``:
 measured chains of capsules of the fingertip's radius and the palm box's tilted underside, against
 the model's own mesh geoms. The Jaco's agree as closely as our hand's; the Inspire's links are
 wider than its fingertips and its palm is a box, so its band is wider (:data:`BANDS`).

@@ -126,7 +126,7 @@ def test_radii_lengths_and_knuckles_come_from_the_file():
 
 
 def test_the_issue_diagnosis_of_the_open_fingers():
-    # Issue 16: fingers lean 18.0 deg, the thumb 24.6 deg; knuckles 31 mm (thumb 51 mm) inward of the
+    # fingers lean 18.0 deg, the thumb 24.6 deg; knuckles 31 mm (thumb 51 mm) inward of the
     # tips; links 55 + 45 mm (thumb 67 + 55 mm); radius 9 mm (11 mm).
     model = build_hand(HAND)
     for f in model.fingers:

@@ -1,4 +1,4 @@
-"""The descent check against analytic truth (issue 16, item 1.3): a flat wall, a vertical cylinder, the lean rule."""
+"""The descent check against analytic truth: a flat wall, a vertical cylinder, the lean rule."""
 
 import math
 from dataclasses import replace
@@ -49,7 +49,7 @@ def lean(chain):
 
 
 def offset(chain, wall, tip_height):
-    """The issue's rule: how far outside a wall edge of height ``wall`` the tip must start, m."""
+    """The lean rule: how far outside a wall edge of height ``wall`` the tip must start, m."""
     tilt, r = lean(chain)
     return r / math.cos(tilt) + math.tan(tilt) * (wall - tip_height)
 
@@ -120,7 +120,7 @@ def test_a_vertical_cylinder_rim(hand):
 
 @pytest.mark.parametrize("name, wall", [("middle", 0.03), ("middle", 0.08), ("thumb", 0.05)])
 def test_the_lean_rule_r_over_cos_plus_tan_times_wall_height(hand, name, wall):
-    """The clearance of the finger's lowest body changes sign where the issue's rule says, within a cell."""
+    """The clearance of the finger's lowest body changes sign where the lean rule says, within a cell."""
     i, chain = finger(hand, name)
     tip = chain_tip(chain, 0.0)[0]
     outward = np.asarray(chain.direction) * -1.0  # open fingers lean away from their flexion direction

@@ -288,7 +288,7 @@ def test_an_attempts_reason_is_worked_out_once_and_only_when_asked():
 def test_a_search_whose_first_attempts_fail_leaves_nothing_for_the_garbage_collector():
     """The failed attempts are kept for the no-plan message. Kept with their tracebacks, they held the
     search's frames, and so every screen of the grid, in reference cycles that only the cyclic garbage
-    collector frees, late and in bulk (``benchmarks/planning_time.md``, "The slow plan in every few")."""
+    collector frees, late and in bulk: a slow plan in every few."""
     plan = cg.synthesize(cg.example_contour("can"), "five-finger-linear", planner="default")
     assert plan.hand.min_touching < cg.load_hand("five-finger-linear").min_touching  # attempts failed before it
     gc.collect()

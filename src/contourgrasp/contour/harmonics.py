@@ -126,7 +126,7 @@ def choose_harmonics(
       (Gibbs) into several small concave dips, while the thesis wants a flat
       side to read as one concave stretch (3.2), as the low harmonics give.
 
-    The default tolerance comes from the sweep in ``benchmarks/harmonics_sweep.md``.
+    The default tolerance comes from ``python tools/harmonics_figure.py --sweep --sim`` (docs/studies.md).
 
     Examples
     --------

@@ -175,7 +175,7 @@ _INSPIRE_FINGERS = ("thumb", "index", "middle", "ring", "pinky")
 #: Inspire hand's thumb rotation is its own motor: held opposed (the high end), not part of the synergy; it is read
 #: :data:`LEVEL` (chosen on ycb-train and the thesis's five: docs/hand-models.md, "The bench on the models"). The Jaco's
 #: fingers each hold their own position: its squeeze's balance is off (max_imbalance 1), chosen on its ycb-train
-#: and thesis's-five trials (benchmarks/balance_sweep.md). The Inspire's fingertips brush the table
+#: and thesis's-five trials (docs/studies.md). The Inspire's fingertips brush the table
 #: (tips_brush_table), the Jaco's do not: chosen on the same trials (docs/hand3d.md, "The 3-D hand in the plan"). The
 #: Inspire's curling fingers are asked for no part of the object's height (grasp_height_fraction 0) and are planned on
 #: the outline seen (slice_contour false): both chosen on its ycb-train trials (docs/hand-models.md, "The bench on the

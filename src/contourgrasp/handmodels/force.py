@@ -4,7 +4,7 @@ The model is closed as :mod:`contourgrasp.handmodels.derive` closes it to derive
 docstring: palm fixed, gravity and contacts off, the synergy ramped from open to closed), and the
 drives' joint forces are read part way through. Not part of the hand file: the planner's squeeze
 balance takes every finger as pushing equally hard (docs/hand-models.md, "The bench on the models", and
-``benchmarks/balance_sweep.md``, for what weighing them did).
+``docs/studies.md``, for what weighing them did).
 """
 
 from __future__ import annotations

@@ -9,7 +9,7 @@ which is the thesis's setting)::
 
     name = "my-planner"
     description = "..."
-    harmonics = 4                # EFD harmonics, or "adaptive" (efd.choose_harmonics)
+    harmonics = 4                # EFD harmonics, or "adaptive" (contour.choose_harmonics)
     curvature = "paper"          # or "geometric"
     xy_step = 0.05               # grid step in x and y, m (Table 4.1)
     yaw_step = 0.0349066         # grid step in yaw, rad (2 deg)

@@ -1,4 +1,4 @@
-"""Every object standing on the support surface, and which one to grasp (issue 17, first part).
+"""Every object standing on the support surface, and which one to grasp.
 
 :func:`find_candidates` lists every connected region standing on the support
 plane -- the same regions depth segmentation chooses from

@@ -1,4 +1,4 @@
-"""The object's cross-section at a height: the outline the closing fingertips meet (issue 16, item 1.4).
+"""The object's cross-section at a height: the outline the closing fingertips meet.
 
 The planner's contour is the object's outline as the camera saw it, projected on one plane: for a
 tall object seen from above and off the optical axis, its visible side wall is in the mask too, so

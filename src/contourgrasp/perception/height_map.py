@@ -1,4 +1,4 @@
-"""A height map of the scene: height above the table on a grid in the planning frame (issue 16, item 1.2).
+"""A height map of the scene: height above the table on a grid in the planning frame.
 
 The planner sees the object as a 2-D outline; a hand descending onto it is 3-D. The height map is
 what a descent check and a grasp height are judged against: for every cell of a regular grid in

@@ -1,4 +1,4 @@
-"""The support surface: the plane the objects rest on, a table or a bin's floor (issue 17).
+"""The support surface: the plane the objects rest on, a table or a bin's floor.
 
 The plane with most pixels (:func:`~contourgrasp.perception.fit_table_plane`)
 is the table when one object stands on an empty table, but not in a bin

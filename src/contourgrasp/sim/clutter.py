@@ -1,4 +1,4 @@
-"""Scenes of several objects (issue 17): clutter on the table, objects in a bin, a seeded tilted camera.
+"""Scenes of several objects: clutter on the table, objects in a bin, a seeded tilted camera.
 
 Kinds (:data:`SCENE_KINDS`)
     ``single``

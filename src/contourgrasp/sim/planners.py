@@ -53,9 +53,9 @@ from ..io.planner_file import Planner, load_planner, planner_names
 from ..validation import flat_options
 
 #: The ablation from ``paper`` to ``default``: each step takes ``default``'s values of these options. Then come
-#: the 3-D hand's steps (issue 16): finger bodies against the height map (with the executor's old grasp height),
+#: the 3-D hand's steps: finger bodies against the height map (with the executor's old grasp height),
 #: the planned grasp height, the closing sweep, the small-object rule; the closing fingers kept clear of
-#: obstacles (issue 17); the squeeze's balance; then the cross-section at the grasp height (in ``default``
+#: obstacles; the squeeze's balance; then the cross-section at the grasp height (in ``default``
 #: only where the outline seen has no balanced squeeze); the object between thumb and index; last, the
 #: low-object rule.
 ABLATION_STEPS: tuple[tuple[str, tuple[str, ...]], ...] = (

@@ -132,7 +132,7 @@ class Workspace:
 
 @dataclass(frozen=True)
 class Bin:
-    """An open box fixed on the table (issue 17's bin scene): floor, four walls, all of thickness ``wall``.
+    """An open box fixed on the table (the bin scene): floor, four walls, all of thickness ``wall``.
 
     World frame: the floor's top is the plane z = 0 on which the objects rest (the
     table around the bin lies ``floor`` lower), centred on the camera's axis.

@@ -13,7 +13,7 @@ the scene adds the seeded random yaw and position as for the thesis's objects.
 The split
 ---------
 :data:`YCB_TRAIN` (21 ids) and :data:`YCB_TEST` (20 ids), one object per YCB
-family, are fixed by issue 15 so that nobody tunes on the test objects: every
+family, are fixed so that nobody tunes on the test objects: every
 planner sweep, gain, threshold or rule is chosen on ``ycb-train`` (and the
 thesis's five) only, and ``ycb-test`` is the figure that generalises. Every
 other id of the package stays available by name.
@@ -50,14 +50,14 @@ from pathlib import Path
 from ..errors import SimulationError, UnknownYCBObject, YCBNotInstalled
 from .objects import THESIS_OBJECTS, ObjectSpec, default_cache_dir, mesh_object, object_spec
 
-#: The YCB objects the bench tunes on (issue 15): 21 ids, one per family.
+#: The YCB objects the bench tunes on: 21 ids, one per family.
 YCB_TRAIN = (
     "003_cracker_box", "005_tomato_soup_can", "006_mustard_bottle", "007_tuna_fish_can", "009_gelatin_box",
     "012_strawberry", "013_apple", "015_peach", "017_orange", "021_bleach_cleanser", "025_mug", "026_sponge",
     "030_fork", "037_scissors", "043_phillips_screwdriver", "050_medium_clamp", "054_softball", "056_tennis_ball",
     "061_foam_brick", "065-d_cups", "073-a_lego_duplo",
 )
-#: The YCB objects the bench reports and never tunes on (issue 15): 20 ids, disjoint from :data:`YCB_TRAIN`.
+#: The YCB objects the bench reports and never tunes on: 20 ids, disjoint from :data:`YCB_TRAIN`.
 YCB_TEST = (
     "002_master_chef_can", "004_sugar_box", "008_pudding_box", "010_potted_meat_can", "011_banana", "014_lemon",
     "016_pear", "018_plum", "022_windex_bottle", "031_spoon", "036_wood_block", "038_padlock", "044_flat_screwdriver",

@@ -32,7 +32,7 @@ BUCKETS = 64
 #: Consecutive contour edges held in one disc and bucketed as one: the buckets are rebuilt for every
 #: (yaw, first chord), so building them must cost little. With 64 buckets, 2 edges a group screens the
 #: dense grid 12 % faster than 4 in 32 buckets, and the thesis grid's (1.3 ms) 0.3 ms slower
-#: (benchmarks/planning_time.md).
+#: (`benchmarks/search_speed.py`).
 GROUP = 2
 
 #: A (yaw, first chord) with at most this many grid positions near the contour scans every edge group

@@ -1,4 +1,4 @@
-"""Descent check: does the open hand, lowered onto the scene, pass above the height map? (issue 16, item 1.3)
+"""Descent check: does the open hand, lowered onto the scene, pass above the height map?
 
 :func:`descent_clearance` and :func:`descent_feasible` are the exact check of candidate poses;
 :func:`~contourgrasp.synthesis.search` applies it, given a :class:`Descent`, to its candidates in
@@ -59,7 +59,7 @@ the three parts' lowest points:
   ball, which already counts). A vertical axis (``1 - b^2`` ~ 0, the posts) has only the balls'.
 
 For a finger leaning outward by ``tilt`` and a wall edge of height H crossed by its distal link,
-this gives the issue's rule: the tip must start ``r / cos(tilt) + tan(tilt) (H - h_tip)``
+this gives the lean rule: the tip must start ``r / cos(tilt) + tan(tilt) (H - h_tip)``
 outside the edge (the vertical half-thickness of an inclined cylinder is ``r / sin(tilt)``
 about its axis).
 

@@ -1,4 +1,4 @@
-"""Grasp height: how far above the table the open hand's fingertips stop (issue 16, item 1.4).
+"""Grasp height: how far above the table the open hand's fingertips stop.
 
 The thesis's hand descends to a depth its operator chose (3.1.1, 4.1.4). With a 3-D hand and the
 scene's height map the planner chooses it, as the height above the table of the open hand's lowest

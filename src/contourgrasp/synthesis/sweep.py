@@ -1,4 +1,4 @@
-"""Closing sweep: what each finger's chain meets while it closes (issues 16, item 1.5, and 17).
+"""Closing sweep: what each finger's chain meets while it closes.
 
 The thesis's fingertip is a point on a ray or an arc: it meets the contour after travelling
 ``lambda`` (eq 3.22). The 3-D finger is a chain of capsules that sweeps a surface while it closes,
