@@ -393,3 +393,23 @@ def test_the_help_gives_the_options_own_defaults(capsys):
     assert f"(default {defaults.perception.approach_offset:g})" in shown
     assert f"pre-grasp distance, m (default {defaults.standoff:g})" in shown
     assert f"(default {defaults.search.top_k})" in shown and f"(default {defaults.perception.segment})" in shown
+
+
+@pytest.mark.parametrize("argv, extra", [
+    (["bench", "--objects", "can", "--trials", "1"], "sim"),
+    (["hand-from-model", "inspire", "--out", "hand.toml"], "sim"),
+    (["calibrate"], "sim"),
+])
+def test_a_command_whose_extra_is_missing_names_it_in_one_line(tmp_path, argv, extra):
+    """Without the [sim] extra (MuJoCo made unimportable in a fresh interpreter) planning still works and the
+    simulation's commands say which extra to install."""
+    code = ("import sys; sys.modules['mujoco'] = None\n"
+            "from contourgrasp.cli import main\n"
+            f"assert main(['synth', '--contour', 'example:can', '--hand', 'three-finger', '--yaw-step-deg', '30',"
+            f" '--out', {str(tmp_path / 'plan.json')!r}]) == 0\n"
+            f"sys.exit(main({argv!r}))")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, timeout=300)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.strip().splitlines()[-1] == (f"contourgrasp: error: {argv[0]} needs mujoco, which is not "
+                                                    f"installed: pip install 'contourgrasp[{extra}]'")
+    assert (tmp_path / "plan.json").is_file() and not (tmp_path / "hand.toml").exists()

@@ -518,7 +518,7 @@ def _ros(args) -> int:
     try:
         from .ros.node import main as node_main
     except ImportError as err:
-        raise InputError(f"the ROS 2 node needs {err.name}: install contourgrasp[ros]") from None
+        raise InputError(f"ros needs {err.name}, which is not installed: pip install 'contourgrasp[ros]'") from None
     return node_main(args.ros_args)
 
 

@@ -338,7 +338,7 @@ def test_the_ros_command_without_the_extra_says_install_it(monkeypatch, capsys):
     monkeypatch.delitem(sys.modules, "contourgrasp.ros.node")
     assert contourgrasp_cli(["ros"]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "install contourgrasp[ros]" in err
+    assert err.count("\n") == 1 and "pip install 'contourgrasp[ros]'" in err
 
 
 def test_no_object_and_no_feasible_grasp_are_one_line_reasons(ros, tmp_path):

@@ -42,7 +42,7 @@ def read_bag_frame(path, color_topic: str, depth_topic: str, info_topic: str, *,
         from rosbags.highlevel import AnyReader, AnyReaderError
         from rosbags.typesys import Stores, get_typestore
     except ImportError:
-        raise InputError("reading bags needs the rosbags package: install contourgrasp[ros]") from None
+        raise InputError("plan --bag needs rosbags, which is not installed: pip install 'contourgrasp[ros]'") from None
     try:
         with AnyReader([path], default_typestore=get_typestore(Stores.ROS2_JAZZY)) as reader:
             colour, depth, info = _frame_messages(reader, path, color_topic, depth_topic, info_topic, index, tolerance)
