@@ -1,4 +1,4 @@
-"""The height map (issue 16, item 1.2): its object height against the simulation's exact truth, and its cost.
+"""The height map: its object height against the simulation's exact truth, and its cost.
 
 (a) Accuracy: the five thesis objects and a standing can, rendered by ``contourgrasp.sim`` (seeds 0-2,
     camera 0.7 m above the table, top-down and tilted 12.7 deg, exact depth and the sensor's noise),
