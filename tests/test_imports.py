@@ -2,6 +2,7 @@
 planning path needs no simulation package (the ``[sim]`` extra)."""
 
 import ast
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -100,3 +101,14 @@ def test_no_stage_imports_one_that_imports_it_back():
         graph.setdefault(_stage(name), set()).update(_stage(m) for m in _imported(name, path) if _stage(m) != _stage(name))
     assert graph["contourgrasp.ros"] >= {"contourgrasp.io"}  # the graph is read
     assert _cycle(graph) is None, " -> ".join(_cycle(graph))
+
+
+def test_every_benchmark_and_tool_answers_help():
+    """A fresh clone's user reads what a script does before running it: ``--help`` writes nothing and exits 0."""
+    repo = Path(__file__).resolve().parents[1]
+    scripts = sorted(repo.glob("benchmarks/*.py")) + sorted(repo.glob("tools/*.py"))
+    assert len(scripts) >= 10
+    for script in scripts:
+        done = subprocess.run([sys.executable, str(script), "--help"], capture_output=True, text=True, timeout=300,
+                              cwd=repo, env=os.environ | {"MPLBACKEND": "Agg"})
+        assert done.returncode == 0 and "usage:" in done.stdout, (script.name, done.stderr[-500:])

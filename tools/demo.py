@@ -8,6 +8,7 @@ summary.md, a table of what was planned. Every plan uses the command's default
 planner, `default` (src/contourgrasp/data/planners/default.toml).
 """
 
+import argparse
 import contextlib
 import io
 import json
@@ -66,4 +67,6 @@ def main(out: Path) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main(Path(sys.argv[1] if len(sys.argv) > 1 else "demo-output")))
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("out", nargs="?", default="demo-output", help="output folder (default demo-output)")
+    sys.exit(main(Path(parser.parse_args().out)))

@@ -5,6 +5,7 @@ the origin); this script documents how they were made. Run it from the
 repository root: ``python tools/make_example_contours.py``.
 """
 
+import argparse
 from pathlib import Path
 
 import numpy as np
@@ -85,6 +86,7 @@ SHAPES = {
 
 
 def main() -> None:
+    argparse.ArgumentParser(description=__doc__.splitlines()[0]).parse_args()
     OUT.mkdir(parents=True, exist_ok=True)
     for name, make in SHAPES.items():
         pts = resample(make())

@@ -3,7 +3,7 @@
 Usage: .venv/bin/python tools/plan3d_figure.py [docs/plan-3d.png]
 """
 
-import sys
+import argparse
 
 from contourgrasp import load_hand, pipeline
 from contourgrasp.io.planner_file import load_planner
@@ -21,4 +21,6 @@ def main(out: str = "docs/plan-3d.png") -> None:
 
 
 if __name__ == "__main__":
-    main(*sys.argv[1:])
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("out", nargs="?", default="docs/plan-3d.png", help="the PNG to write (default docs/plan-3d.png)")
+    main(parser.parse_args().out)

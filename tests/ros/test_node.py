@@ -423,3 +423,11 @@ def test_fuzz_the_parameters_give_settings_or_one_input_error():
             assert str(err).startswith("parameter ") and "\n" not in str(err)
 
     check()
+
+
+def test_parameters_that_fit_alone_but_not_together_are_refused_naming_them():
+    from contourgrasp.ros.node import settings_from_parameters
+
+    with pytest.raises(InputError, match=r"^parameters .*xy_step, yaw_step_deg together: the search grid would have"):
+        settings_from_parameters({"planner": "paper", "xy_step": 0.005, "yaw_step_deg": 1.0})
+    assert settings_from_parameters({"planner": "paper", "xy_step": 0.005}).options.search.grid.xy_step == 0.005

@@ -45,14 +45,14 @@ from ..io.plan_file import image_plan_to_dict
 from ..io.planner_file import Planner, load_planner
 from ..pipeline import PlanOptions, plan_frame
 from ..threads import one_blas_thread
-from . import messages
 from ..validation import with_options
+from . import messages
 from .pairing import PAIR_TOLERANCE, Pairer
 
-#: QoS of the subscriptions: best effort (it receives from reliable publishers too), a queue of one, so that a
-#: node busy planning goes on with the newest images rather than falling behind the camera.
 #: The options' defaults, which the parameters' defaults are.
 DEFAULTS = PlanOptions()
+#: QoS of the subscriptions: best effort (it receives from reliable publishers too), a queue of one, so that a
+#: node busy planning goes on with the newest images rather than falling behind the camera.
 NEWEST = QoSProfile(depth=1, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.BEST_EFFORT)
 
 DEPTH_MODE_CHOICES = ("", "max", "plane")
@@ -113,7 +113,10 @@ def settings_from_parameters(values: dict) -> Settings:
         except InputError as err:
             parameter = PARAMETER_OF.get(name, name)
             raise InputError(f"parameter {parameter}: {str(err).removeprefix(name + ' ')}") from None
-    options = with_options(planner.options, given, what="parameters", error=InputError)
+    try:
+        options = with_options(planner.options, given, what="parameters", error=InputError)
+    except InputError as err:  # each one fits, not all of them together (a grid too large)
+        raise InputError(f"parameters {', '.join(PARAMETER_OF.get(n, n) for n in given)} together: {err}") from None
     return Settings(hand, planner, v["pair_tolerance"], v["continuous"], options, target_pixel(v["target"]))
 
 
