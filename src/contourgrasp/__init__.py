@@ -7,13 +7,16 @@ The pipeline, one package or module per stage (thesis chapter 3):
 * :mod:`contourgrasp.hand` — finger trajectories, finger chains and hands (3.3)
 * :mod:`contourgrasp.synthesis` — inner and outer problems, the grasp plan (3.4)
 * :mod:`contourgrasp.quality` — force closure and the Ferrari-Canny epsilon (6.1 item 2)
-* :mod:`contourgrasp.pipeline` — perception + synthesis -> 6-DoF grasp pose (4.1.4)
+* :mod:`contourgrasp.pipeline` — perception + synthesis -> 6-DoF grasp pose (4.1.4); its options,
+  :class:`~contourgrasp.pipeline.PlanOptions`
 * :mod:`contourgrasp.visualize` — figures
-* :mod:`contourgrasp.sim` — MuJoCo simulation of the grasping experiment and the bench (4.2.4)
-* :mod:`contourgrasp.io` — file formats (contours, hands, planners, camera files, bags, plans)
+* :mod:`contourgrasp.handmodels` — hand files from MuJoCo models of hands (the ``[sim]`` extra)
+* :mod:`contourgrasp.sim` — MuJoCo simulation of the grasping experiment and the bench (4.2.4; ``[sim]``)
+* :mod:`contourgrasp.io` — file formats (contours, hands, planners, camera files, plans)
 * :mod:`contourgrasp.validation`, :mod:`contourgrasp.tolerances`, :mod:`contourgrasp.errors` —
   argument checks, thresholds, exceptions
-* :mod:`contourgrasp.cli`, :mod:`contourgrasp.ros` — the ``contourgrasp`` command and the ROS 2 node
+* :mod:`contourgrasp.cli`, :mod:`contourgrasp.ros` — the ``contourgrasp`` command; the ROS 2 node and rosbag2
+  frames (``[ros]``)
 """
 
 from __future__ import annotations
