@@ -456,7 +456,7 @@ def main(argv=None) -> int:
           f"best {max(tol.REFINE_CANDIDATES, 40)} screened poses; (d) adds refine=True: compass search from the best "
           f"{tol.REFINE_STARTS} distinct poses), median of {args.runs} runs after 1 untimed warm-up "
           "call per grid (numba JIT / cache loading excluded).")
-    print("Reference: benchmarks/reference_nested.reference_search (scipy L-BFGS-B per finger per pose), 1 run, "
+    print("Reference: contourgrasp.synthesis.reference.reference_search (scipy L-BFGS-B per finger per pose), 1 run, "
           f"thesis grid only, hands: {', '.join(sorted(ref_hands)) or 'none'}.")
     print("Peak mem: tracemalloc peak of one extra, untimed library call (Python + numpy + numba-runtime heap "
           "allocations during the call).")
