@@ -22,6 +22,7 @@ FRAME = REPO / "examples" / "bar_clamp"
 SHARED = Path(os.environ.get("CONTOURGRASP_SHARED_DATA", REPO.parent / "shared" / "data"))
 SINGLE = SHARED / "rgbd" / "gqcnn_primesense_single_object"
 needs_data = pytest.mark.skipif(not SINGLE.is_dir(), reason=f"real RGB-D frames not found at {SINGLE}")
+needs_shared = pytest.mark.skipif(not (SHARED / "rgbd").is_dir(), reason=f"the shared real frames are not at {SHARED}")
 FAST = {"xy_step": 0.03, "yaw_step": math.radians(6)}
 
 
@@ -571,3 +572,32 @@ def test_an_integer_beyond_floats_range_is_an_input_error_for_intrinsics(name):
     fields = {"fx": 525.0, "fy": 525.0, "cx": 319.5, "cy": 239.5, "width": 640, "height": 480} | {name: 10**400}
     with pytest.raises(cg.InputError, match=name):
         Intrinsics(**fields)
+
+
+def test_colour_at_twice_the_resolution_plans_as_the_registered_pair(tmp_path):
+    """The bundled frame's colour doubled (as a PhoXi or a RealSense colour stream gives it): the same plan."""
+    frame = bundled()
+    doubled = cv2.resize(frame.rgb, None, fx=2, fy=2, interpolation=cv2.INTER_NEAREST)
+    same = cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, "three-finger", yaw_step=0.2)
+    scaled = cg.plan_grasp(doubled, frame.depth, frame.intrinsics, "three-finger", yaw_step=0.2)
+    np.testing.assert_array_equal(scaled.segmentation.mask, same.segmentation.mask)
+    np.testing.assert_allclose(scaled.T_camera_hand, same.T_camera_hand)
+    cv2.imwrite(str(tmp_path / "color.png"), cv2.cvtColor(doubled, cv2.COLOR_RGB2BGR))
+    args = ["plan", "--rgb", str(tmp_path / "color.png"), "--depth", str(FRAME / "depth_0.npy"),
+            "--intrinsics", str(FRAME / "primesense_overhead_color.intr"), "--hand", "three-finger",
+            "--yaw-step-deg", "11.46", "--out", str(tmp_path / "plan.json"), "--plot", str(tmp_path / "plan.png")]
+    assert main(args) == 0
+    wide = cv2.resize(frame.rgb, (800, 480))
+    cv2.imwrite(str(tmp_path / "wide.png"), wide)
+    args[2] = str(tmp_path / "wide.png")
+    assert main(args) == 2
+
+
+@needs_shared
+def test_the_phoxi_frames_colour_at_twice_its_depth_is_read_with_its_own_intrinsics():
+    folder = SHARED / "rgbd" / "real_gqcnn_phoxi_fcgqcnn_2"
+    frame = cg.read_rgbd(folder / "color.png", folder / "depth.npy", folder / "camera.yaml")
+    assert frame.rgb.shape == (772, 1032, 3) and frame.colour_intrinsics.fx == 1105.0
+    on_depth = cg.perception.colour_on_depth(frame.rgb, frame.depth.shape, intrinsics=frame.intrinsics,
+                                             colour_intrinsics=frame.colour_intrinsics)
+    assert on_depth.shape == (386, 516, 3)

@@ -422,6 +422,7 @@ def _plan(args) -> int:
     frame = _bag_frame(args) if args.bag else _read_frame(args)
     if frame.depth is None:
         raise InputError("plan needs --depth and --intrinsics, or --bag")
+    frame = _colour_on_depth(frame)
     options = _plan_options(args)
     extrinsics = None if args.extrinsics is None else read_extrinsics(args.extrinsics)
     if args.all:
@@ -436,6 +437,20 @@ def _plan(args) -> int:
 
     _write_outputs(args, image_plan_to_dict(result), figure, _summary(result.plan))
     return EXIT_OK
+
+
+def _colour_on_depth(frame):
+    """``frame`` with its colour on the depth image's grid (the plan and its picture draw in depth pixels)."""
+    from dataclasses import replace
+
+    from .perception import colour_on_depth
+
+    if frame.rgb is None or frame.rgb.shape[:2] == frame.depth.shape[:2]:
+        return frame
+    colour_k = frame.colour_intrinsics
+    rgb = colour_on_depth(frame.rgb, frame.depth.shape, intrinsics=None if colour_k is None else frame.intrinsics,
+                          colour_intrinsics=colour_k)
+    return replace(frame, rgb=rgb, colour_intrinsics=None)
 
 
 def _plan_all(args, frame, options, extrinsics) -> int:

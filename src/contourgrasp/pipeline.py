@@ -152,6 +152,7 @@ def plan_frame(
     target_px=None,
     roi=None,
     T_base_camera=None,
+    colour_intrinsics: Intrinsics | None = None,
 ) -> ImageGraspPlan:
     """Plan a grasp on one RGB-D frame with a :class:`~contourgrasp.hand.Hand`.
 
@@ -160,11 +161,13 @@ def plan_frame(
 
     Parameters
     ----------
-    rgb : (H, W, 3) uint8 or None
-        Colour image, RGB order, registered to ``depth``.
+    rgb : (H', W', 3) or (H', W') uint8, or None
+        Colour image, RGB order, registered to ``depth``; at another resolution it is resampled onto the
+        depth image's grid (:func:`contourgrasp.perception.colour_on_depth`).
     depth : (H, W) float
         Depth in meters (0 or NaN where missing).
     intrinsics : Intrinsics
+        Of the depth image.
     hand : Hand
     options : PlanOptions
         Perception, search and 3-D options (:class:`PlanOptions`; the defaults are the thesis's).
@@ -183,6 +186,9 @@ def plan_frame(
     T_base_camera : (4, 4) float, optional
         Camera pose in the robot's base frame, a rigid transform (checked as
         :func:`contourgrasp.io.camera_file.read_extrinsics` checks a file's).
+    colour_intrinsics : Intrinsics, optional
+        The colour camera's, when ``rgb`` has another resolution than ``depth`` and not the same view
+        scaled.
 
     Notes
     -----
@@ -221,7 +227,7 @@ def plan_frame(
     with perception.one_frame():
         seg, metric, filled, d, table, scene = _perceive(
             rgb, depth, intrinsics, options.perception, mask=mask, target_px=target_px, roi=roi,
-            max_width=perception.hand_opening(hand))
+            max_width=perception.hand_opening(hand), colour_intrinsics=colour_intrinsics)
         heights = scene_heights(d, intrinsics, seg, metric, plane=table)
     asked = _grasp_height(hand, heights, scene_options)
     spec = (Descent(heights, *asked, sweep=scene_options.closing_sweep, closing=scene_options.closing_obstacles)
@@ -301,17 +307,19 @@ def find_objects(depth, intrinsics: Intrinsics, *, fill_holes: bool = True) -> p
 
 
 def perceive(rgb, depth, intrinsics: Intrinsics, options: PerceptionOptions = PerceptionOptions(), *, mask=None,
-             target_px=None) -> tuple[Segmentation, MetricContour, int]:
+             target_px=None, colour_intrinsics: Intrinsics | None = None) -> tuple[Segmentation, MetricContour, int]:
     """The perception half of :func:`plan_frame`: (segmentation, metric contour, filled depth pixels).
 
     Checks the depth, fills small holes, segments (or takes ``mask``) and puts
     the contour in meters; the arguments are :func:`plan_frame`'s.
     """
     with perception.one_frame():
-        return _perceive(rgb, depth, intrinsics, options, mask=mask, target_px=target_px)[:3]
+        return _perceive(rgb, depth, intrinsics, options, mask=mask, target_px=target_px,
+                         colour_intrinsics=colour_intrinsics)[:3]
 
 
-def _perceive(rgb, depth, intrinsics, options: PerceptionOptions, *, mask, target_px=None, roi=None, max_width=None):
+def _perceive(rgb, depth, intrinsics, options: PerceptionOptions, *, mask, target_px=None, roi=None, max_width=None,
+              colour_intrinsics=None):
     """:func:`perceive`, the depth image it worked on (holes filled), the support plane (None if there is
     none: found once here, :func:`contourgrasp.perception.find_support`, and shared by segmentation, the
     metric contour and the height map), and (candidates, target, reason, support).
@@ -340,6 +348,9 @@ def _perceive(rgb, depth, intrinsics, options: PerceptionOptions, *, mask, targe
         raise PerceptionError("target_px and roi choose among the depth candidates: not with a mask or segment='rgb'")
     d = perception.as_depth(depth)
     intrinsics.check_shape(d.shape, "depth image")
+    if rgb is not None:
+        rgb = perception.colour_on_depth(rgb, d.shape, intrinsics=None if colour_intrinsics is None else intrinsics,
+                                         colour_intrinsics=colour_intrinsics)
     if not perception.valid_depth(d).any():
         raise PerceptionError("the depth image has no valid reading (all 0, NaN or outside the sensor range)")
     filled = 0

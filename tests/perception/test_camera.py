@@ -92,3 +92,41 @@ def test_project_inverts_rays():
     pixels = np.array([[0.0, 0.0], [319.5, 239.5], [600.2, 33.7]])
     points = k.rays(pixels) * np.array([[0.5], [0.7], [1.3]])
     np.testing.assert_allclose(k.project(points), pixels, atol=1e-9)
+
+
+def test_colour_at_twice_the_depths_resolution_is_averaged_back_onto_its_grid():
+    from contourgrasp.perception import colour_on_depth
+
+    rng = np.random.default_rng(0)
+    rgb = rng.integers(0, 255, (48, 64, 3), dtype=np.uint8)
+    doubled = cv2.resize(rgb, (128, 96), interpolation=cv2.INTER_NEAREST)
+    np.testing.assert_array_equal(colour_on_depth(doubled, (48, 64)), rgb)
+    depth_k = Intrinsics(fx=60.0, fy=60.0, cx=31.5, cy=23.5, width=64, height=48)
+    colour_k = Intrinsics(fx=120.0, fy=120.0, cx=63.5, cy=47.5, width=128, height=96)
+    np.testing.assert_array_equal(colour_on_depth(doubled, (48, 64), intrinsics=depth_k, colour_intrinsics=colour_k),
+                                  rgb)
+    assert colour_on_depth(rgb, (48, 64)) is not None and colour_on_depth(rgb, (48, 64)).shape == (48, 64, 3)
+
+
+def test_colour_of_another_view_maps_through_the_two_intrinsics():
+    """A colour camera with a wider view (another focal length and principal point): depth pixel (u, v) takes the
+    colour at cx_c + (u - cx) fx_c / fx, analytically."""
+    from contourgrasp.perception import colour_on_depth
+
+    u, v = np.meshgrid(np.arange(120), np.arange(90))
+    colour = np.dstack([u % 256, v % 256, np.zeros_like(u)]).astype(np.uint8)  # each pixel holds its own (u, v)
+    colour_k = Intrinsics(fx=50.0, fy=50.0, cx=62.0, cy=44.0, width=120, height=90)
+    depth_k = Intrinsics(fx=100.0, fy=100.0, cx=40.0, cy=30.0, width=80, height=60)
+    on_depth = colour_on_depth(colour, (60, 80), intrinsics=depth_k, colour_intrinsics=colour_k)
+    for du, dv in ((0, 0), (10, 20), (79, 59), (40, 30)):
+        expected = (62.0 + (du - 40.0) * 0.5, 44.0 + (dv - 30.0) * 0.5)
+        np.testing.assert_allclose(on_depth[dv, du, :2], expected, atol=1.0)
+
+
+def test_colour_of_another_aspect_without_its_intrinsics_is_refused():
+    from contourgrasp.perception import PerceptionError, colour_on_depth
+
+    with pytest.raises(PerceptionError, match="not the same view at another resolution"):
+        colour_on_depth(np.zeros((90, 200, 3), np.uint8), (60, 80))
+    with pytest.raises(PerceptionError, match="together, or neither"):
+        colour_on_depth(np.zeros((120, 160, 3), np.uint8), (60, 80), intrinsics=CAMERA)

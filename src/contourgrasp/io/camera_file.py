@@ -45,6 +45,7 @@ from .. import tolerances as tol
 from .. import validation
 from ..errors import DepthUnitWarning, InputError
 from ..perception import Intrinsics
+from ..perception.camera import check_colour_size
 from ..tolerances import HOMOGENEOUS_ROW, ROTATION_TOLERANCE
 
 #: Default raw-unit size of integer depth images, m (millimetres).
@@ -68,14 +69,20 @@ class RGBDFrame:
     depth : (H, W) float or None
         Depth in meters, 0 or NaN where missing.
     intrinsics : Intrinsics or None
+        Of the depth image.
     mask : (H, W) bool or None
         The user's object mask (:func:`read_mask`), when one was given.
+    colour_intrinsics : Intrinsics or None
+        The colour camera's, when the intrinsics file gives them (``color_fx``, ... ``color_height``):
+        a colour image at another resolution than the depth is resampled with them
+        (:func:`contourgrasp.perception.colour_on_depth`).
     """
 
     rgb: np.ndarray | None
     depth: np.ndarray | None
     intrinsics: Intrinsics | None
     mask: np.ndarray | None = None
+    colour_intrinsics: Intrinsics | None = None
 
 
 def read_rgb(path) -> np.ndarray:
@@ -182,6 +189,27 @@ def read_intrinsics(path) -> Intrinsics:
         raise InputError(f"{path}: {err}") from None
 
 
+#: The keys of a colour camera's own intrinsics in an intrinsics file, beside the depth camera's.
+COLOUR_KEYS = ("fx", "fy", "cx", "cy", "width", "height")
+
+
+def read_colour_intrinsics(path) -> Intrinsics | None:
+    """The colour camera's intrinsics an intrinsics file gives beside the depth camera's (``color_fx``, ``color_fy``,
+    ``color_cx``, ``color_cy``, ``color_width``, ``color_height``; ``colour_`` too), or None when it gives none."""
+    path = Path(path)
+    data = _read_mapping(path)
+    if not isinstance(data, dict):
+        return None
+    for prefix in ("color_", "colour_"):
+        if any(prefix + key in data for key in COLOUR_KEYS):
+            fields = {key: _field(path, data, prefix + key) for key in COLOUR_KEYS}
+            try:
+                return Intrinsics(**fields)
+            except InputError as err:
+                raise InputError(f"{path}: colour {err}") from None
+    return None
+
+
 def _ros_fields(path, data) -> dict:
     if "camera_matrix" in data:
         matrix = _field(path, data, "camera_matrix")
@@ -282,8 +310,11 @@ def read_rgbd(rgb_path=None, depth_path=None, intrinsics_path=None, *, mask_path
     rgb = None if rgb_path is None else read_rgb(rgb_path)
     depth = None if depth_path is None else read_depth(depth_path, depth_scale=depth_scale)
     intrinsics = None if intrinsics_path is None else read_intrinsics(intrinsics_path)
+    colour_intrinsics = None if intrinsics_path is None else read_colour_intrinsics(intrinsics_path)
     mask = None if mask_path is None else read_mask(mask_path)
-    sized = [(p, a.shape) for p, a in ((rgb_path, rgb), (depth_path, depth), (mask_path, mask)) if a is not None]
+    scaled = rgb is not None and depth is not None and rgb.shape[:2] != depth.shape[:2]
+    sized = [(p, a.shape) for p, a in ((None if scaled else rgb_path, rgb), (depth_path, depth), (mask_path, mask))
+             if a is not None and p is not None]
     if intrinsics is not None:
         sized.append((intrinsics_path, intrinsics.shape))
     for (path_a, shape_a), (path_b, shape_b) in zip(sized, sized[1:]):
@@ -291,7 +322,14 @@ def read_rgbd(rgb_path=None, depth_path=None, intrinsics_path=None, *, mask_path
             raise InputError(
                 f"{path_a} is {shape_a[1]}x{shape_a[0]} but {path_b} is {shape_b[1]}x{shape_b[0]} (width x height)"
             )
-    return RGBDFrame(rgb=rgb, depth=depth, intrinsics=intrinsics, mask=mask)
+    if scaled:  # colour at another resolution: the same view scaled, or mapped by the colour intrinsics
+        try:
+            check_colour_size(rgb.shape, depth.shape, intrinsics=None if colour_intrinsics is None else intrinsics,
+                              colour_intrinsics=colour_intrinsics)
+        except InputError as err:
+            raise InputError(f"{rgb_path}: {err} ({intrinsics_path} gives no color_fx, ...)"
+                             if colour_intrinsics is None else f"{rgb_path}: {err}") from None
+    return RGBDFrame(rgb=rgb, depth=depth, intrinsics=intrinsics, mask=mask, colour_intrinsics=colour_intrinsics)
 
 
 def read_masked_frames(root):

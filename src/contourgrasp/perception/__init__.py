@@ -36,7 +36,7 @@ from __future__ import annotations
 
 from ..errors import PerceptionError, PerceptionWarning, SegmentationError
 from ._frame import one_frame
-from .camera import Intrinsics, as_depth, backproject, denoised_depth, fill_depth_holes, valid_depth
+from .camera import Intrinsics, as_depth, backproject, colour_on_depth, denoised_depth, fill_depth_holes, valid_depth
 from .candidates import TARGET_RULES, Candidate, choose_target, find_candidates, hand_opening, low_part_candidate
 from .colour import add_flat_parts, colour_offset, register_colour
 from .cross_section import cross_section
@@ -53,7 +53,7 @@ from .table import Plane, fit_plane, fit_table_plane
 __all__ = [
     "Candidate", "DEPTH_MODES", "DepthMode", "HeightMap", "Intrinsics", "MetricContour", "PerceptionError", "PerceptionOptions", "PerceptionWarning", "Plane",
     "SEGMENT_METHODS", "SegmentMethod", "Segmentation", "SegmentationError", "Support", "TARGET_RULES", "add_flat_parts", "approach_depth",
-    "as_depth", "backproject", "choose_target", "colour_offset", "contour_to_metric", "denoised_depth", "fill_depth_holes",
+    "as_depth", "backproject", "choose_target", "colour_on_depth", "colour_offset", "contour_to_metric", "denoised_depth", "fill_depth_holes",
     "cross_section", "find_candidates", "find_support", "fit_plane", "fit_table_plane", "hand_opening", "height_map", "low_part_candidate", "mask_contour", "object_footprint", "one_frame", "open_table_holes", "register_colour", "segment",
     "segment_depth", "segment_from_mask", "segment_rgb", "valid_depth",
 ]

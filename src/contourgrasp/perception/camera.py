@@ -296,6 +296,70 @@ def denoised_at(depth, valid, rows, cols) -> np.ndarray:
     return denoised_depth(depth[box], valid[box])[rows - box[0].start, cols - box[1].start]
 
 
+def colour_on_depth(rgb, depth_shape, *, intrinsics: Intrinsics | None = None,
+                    colour_intrinsics: Intrinsics | None = None) -> np.ndarray:
+    """A colour image registered to the depth camera, resampled onto the depth image's pixel grid.
+
+    Cameras give colour at another resolution than depth (a PhoXi's colour at twice its depth's, a
+    RealSense colour stream at 1280 x 720 beside depth at 640 x 480). With both intrinsics, each depth
+    pixel (u, v) takes the colour at ``cx_c + (u - cx) fx_c / fx``, ``cy_c + (v - cy) fy_c / fy`` (the two
+    images registered: one optical centre, no rotation). Without them, the colour image must show the
+    same view at another scale (the same aspect ratio, within a pixel), and is resized.
+
+    Parameters
+    ----------
+    rgb : (H', W', 3) or (H', W') uint8
+    depth_shape : (H, W)
+    intrinsics, colour_intrinsics : Intrinsics, optional
+        Of the depth image and of the colour image; give both or neither.
+
+    Returns
+    -------
+    (H, W, 3) or (H, W) uint8
+        ``rgb`` itself when it has the depth image's size.
+
+    Raises
+    ------
+    PerceptionError
+        Another aspect ratio without the colour intrinsics, or intrinsics of another size than the images.
+    """
+    img = as_image(rgb)
+    height, width = depth_shape[:2]
+    if img.shape[:2] == (height, width):
+        return img
+    check_colour_size(img.shape, depth_shape, intrinsics=intrinsics, colour_intrinsics=colour_intrinsics)
+    if colour_intrinsics is None:
+        shrink = img.shape[1] > width
+        return cv2.resize(img, (width, height), interpolation=cv2.INTER_AREA if shrink else cv2.INTER_LINEAR)
+    sx, sy = colour_intrinsics.fx / intrinsics.fx, colour_intrinsics.fy / intrinsics.fy
+    to_colour = np.array([[sx, 0.0, colour_intrinsics.cx - sx * intrinsics.cx],
+                          [0.0, sy, colour_intrinsics.cy - sy * intrinsics.cy]])
+    resized = np.allclose(to_colour[:, 2], [0.5 * sx - 0.5, 0.5 * sy - 0.5], atol=0.05) and \
+        np.allclose([sx * width, sy * height], img.shape[1::-1], atol=0.5)
+    if resized:  # the colour image is the depth's view at another scale: resized, averaging when it shrinks
+        return cv2.resize(img, (width, height), interpolation=cv2.INTER_AREA if sx > 1.0 else cv2.INTER_LINEAR)
+    return cv2.warpAffine(img, to_colour, (width, height), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
+                          borderMode=cv2.BORDER_REPLICATE)
+
+
+def check_colour_size(colour_shape, depth_shape, *, intrinsics: Intrinsics | None = None,
+                      colour_intrinsics: Intrinsics | None = None) -> None:
+    """Refuse a colour image :func:`colour_on_depth` cannot put on the depth image's grid (its docstring)."""
+    (height, width), (colour_height, colour_width) = depth_shape[:2], colour_shape[:2]
+    if (colour_height, colour_width) == (height, width):
+        return
+    if (intrinsics is None) != (colour_intrinsics is None):
+        raise PerceptionError("give the depth and the colour intrinsics together, or neither")
+    if colour_intrinsics is None:
+        if abs(colour_height - height * colour_width / width) > 1.0:
+            raise PerceptionError(f"rgb image is {colour_width}x{colour_height} but the depth image is {width}x{height}: "
+                                  f"not the same view at another resolution (the aspect ratios differ); give the "
+                                  f"colour camera's intrinsics, or register the colour to the depth")
+        return
+    check_intrinsics(intrinsics).check_shape((height, width), "depth image")
+    check_intrinsics(colour_intrinsics).check_shape(colour_shape, "rgb image")
+
+
 def as_rgb(rgb) -> np.ndarray:
     """(H, W, 3) uint8: a checked colour image, grayscale expanded to RGB."""
     img = as_image(rgb)

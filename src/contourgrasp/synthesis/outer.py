@@ -20,6 +20,7 @@ under the same constraints.
 from __future__ import annotations
 
 import math
+import re
 import time
 from dataclasses import replace
 from functools import partial
@@ -191,9 +192,9 @@ def _search_rules(contour, hand: Hand, options: SearchOptions, outline, elsewher
 def _led(reason: str) -> str:
     """A failure's reason led by its cause in one sentence: the last attempt's (the most relaxed search, whose failure
     is the plan's), then the attempts, each without that cause repeated."""
-    attempts = reason.split("; ")
+    attempts = re.split(r"; (?=with the |without the )", reason)
     last = attempts[-1] if len(attempts) == 1 else attempts[-1].split(": ", 1)[-1]
-    cause = (last.split("): ", 1)[1] if "): " in last else last).split(" (the same ")[0]
+    cause = (last.split("): ", 1)[1] if "): " in last else last).split(" (the same ")[0].split("; ")[0]
     tried = reason.replace(f"): {cause}", ")")
     return cause if tried == cause else f"{cause}. Tried: {tried}"
 
