@@ -315,8 +315,13 @@ def test_frame_sizes_must_agree(tmp_path):
     cv2.imwrite(str(tmp_path / "c.png"), np.zeros((480, 640, 3), np.uint8))
     np.save(tmp_path / "d.npy", np.full((240, 320), 0.7))
     intr = write(tmp_path / "camera.json", json.dumps(PLAIN))
-    with pytest.raises(InputError, match=r"c.png is 640x480 but .*d.npy is 320x240"):
+    with pytest.raises(InputError, match=r"d.npy is 320x240 but .*camera.json is 640x480"):
         read_rgbd(tmp_path / "c.png", tmp_path / "d.npy", intr)
+    cv2.imwrite(str(tmp_path / "wide.png"), np.zeros((480, 800, 3), np.uint8))
+    np.save(tmp_path / "d640.npy", np.full((480, 640), 0.7))
+    with pytest.raises(InputError, match=r"wide.png: rgb image is 800x480 but the depth image is 640x480: not the same "
+                                         r"view at another resolution .*camera.json gives no color_fx"):
+        read_rgbd(tmp_path / "wide.png", tmp_path / "d640.npy", intr)
     with pytest.raises(InputError, match="needs an intrinsics file"):
         read_rgbd(None, tmp_path / "d.npy")
     frame = read_rgbd(tmp_path / "c.png", None, intr)
@@ -343,8 +348,10 @@ def test_a_mask_of_another_size_names_both_files(tmp_path):
     intr = write(tmp_path / "camera.json", json.dumps(PLAIN))
     with pytest.raises(InputError, match=r"depth.npy is 640x480 but .*mask.png is 320x240"):
         read_rgbd(None, tmp_path / "depth.npy", intr, mask_path=tmp_path / "mask.png")
-    with pytest.raises(InputError, match=r"color.png is 320x240 but .*depth.npy is 640x480"):
+    with pytest.raises(InputError, match=r"depth.npy is 640x480 but .*mask.png is 320x240"):
         read_rgbd(tmp_path / "color.png", tmp_path / "depth.npy", intr, mask_path=tmp_path / "mask.png")
+    half = read_rgbd(tmp_path / "color.png", tmp_path / "depth.npy", intr)  # colour at half the depth's resolution
+    assert half.rgb.shape == (240, 320, 3) and half.depth.shape == (480, 640)
     assert read_rgbd(tmp_path / "color.png", mask_path=tmp_path / "mask.png").mask.shape == (240, 320)
 
 
