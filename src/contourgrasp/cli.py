@@ -168,6 +168,7 @@ def _parser() -> argparse.ArgumentParser:
     plan.add_argument("--extrinsics", help="T_base_camera (4x4): .npy, .txt, .json, .yaml or autolab .tf")
     _add_synthesis_options(plan)
 
+    _add_doctor_parser(sub)
     _add_bench_parser(sub)
     _add_calibrate_parser(sub)
     _add_hand_from_model_parser(sub)
@@ -245,6 +246,21 @@ def _add_synthesis_options(parser) -> None:
                         help="refine the best grid poses continuously (x, y, yaw) and report the gain")
     parser.add_argument("--out", help="write the plan JSON here (default: print it)")
     parser.add_argument("--plot", help="write the plan picture (PNG) here")
+
+
+def _add_doctor_parser(sub) -> None:
+    doctor = sub.add_parser("doctor", help="a first look at a frame: what perception sees in it and what looks wrong")
+    doctor.add_argument("frames", nargs="*", metavar="FRAME",
+                        help="folders each holding one frame: a colour image (color*.png, rgb*.png, *.jpg), a depth "
+                             "image (depth*.npy or *depth*.png) and an intrinsics file (camera.yaml, *.intr, ...)")
+    doctor.add_argument("--rgb", help="instead of a folder: the colour image")
+    doctor.add_argument("--depth", help="instead of a folder: the depth image")
+    doctor.add_argument("--intrinsics", help="instead of a folder: the intrinsics file")
+    doctor.add_argument("--depth-scale", type=_positive_float, default=0.001,
+                        help="meters per unit of integer depth images (default 0.001: millimetres)")
+    doctor.add_argument("--hand", default="five-finger-linear", help="the hand the plan is tried with")
+    doctor.add_argument("--planner", default="default", help="the planner the plan is tried with")
+    doctor.add_argument("--plot", help="the picture (PNG); with several frames, PLOT_<folder>.png for each")
 
 
 def _add_bench_parser(sub) -> None:
@@ -614,6 +630,56 @@ def _calibrate(args) -> int:
     return EXIT_OK
 
 
+#: The files a frame folder's colour, depth and intrinsics are looked for in, in this order.
+FRAME_FILES = {"colour": ("color*.png", "colour*.png", "rgb*.png", "*color*.png", "*rgb*.png", "*.jpg"),
+               "depth": ("depth*.npy", "*depth*.npy", "depth*.png", "*depth*.png"),
+               "intrinsics": ("camera.yaml", "camera_info.yaml", "*.intr", "camera*.json", "intrinsics*", "*.yaml")}
+
+
+def _frame_files(folder: Path) -> tuple[Path, Path, Path]:
+    """The colour image, depth image and intrinsics file of a frame folder (:data:`FRAME_FILES`)."""
+    if not folder.is_dir():
+        raise InputError(f"{folder}: not a folder (give a folder holding one frame, or --rgb, --depth, --intrinsics)")
+    found = {}
+    for kind, patterns in FRAME_FILES.items():
+        found[kind] = next((p for pattern in patterns for p in sorted(folder.glob(pattern)) if p.is_file()), None)
+        if found[kind] is None:
+            raise InputError(f"{folder}: no {kind} file ({', '.join(patterns)})")
+    return found["colour"], found["depth"], found["intrinsics"]
+
+
+def _doctor(args) -> int:
+    from .doctor import diagnose
+    from .io.camera_file import read_rgbd
+
+    given = [args.rgb, args.depth, args.intrinsics]
+    if any(given) and args.frames:
+        raise InputError("give frame folders or --rgb, --depth and --intrinsics, not both")
+    if any(given) and not (args.depth and args.intrinsics):
+        raise InputError("doctor needs --depth and --intrinsics (and --rgb, if there is colour)")
+    frames = [tuple(given)] if any(given) else [_frame_files(Path(f)) for f in args.frames]
+    if not frames:
+        raise InputError("give a frame folder, or --rgb, --depth and --intrinsics")
+    hand, options = load_hand(args.hand), load_planner(args.planner).options
+    plots = [None] * len(frames) if args.plot is None else [args.plot] if len(frames) == 1 else \
+        [_numbered(args.plot, Path(f).name, ".png") for f in args.frames]
+    for (rgb_path, depth_path, intrinsics_path), plot in zip(frames, plots, strict=True):
+        args.rgb, args.depth, args.intrinsics, args.mask = rgb_path, depth_path, intrinsics_path, None
+        frame = _read_frame(args)
+        diagnosis = diagnose(frame.rgb, frame.depth, frame.intrinsics, hand, options=options,
+                             colour_intrinsics=frame.colour_intrinsics)
+        named = ", ".join(str(p) for p in (rgb_path, depth_path, intrinsics_path) if p)
+        print(f"frame: {named}")
+        print("\n".join("  " + line for line in diagnosis.lines()))
+        if plot is not None:
+            from .visualize import doctor_figure
+
+            with atomic_outputs(plot, inputs=[rgb_path, depth_path, intrinsics_path]) as (out,):
+                doctor_figure(diagnosis).savefig(out, dpi=90, format="png")
+            print(f"  picture -> {plot}")
+    return EXIT_OK
+
+
 def _hand_from_model(args) -> int:
     from .io.hand_file import hand_to_toml
     from .handmodels import derive_hand, fit_table
@@ -649,7 +715,7 @@ def _efd(args) -> int:
     return EXIT_OK
 
 
-COMMANDS = {"hands": _hands, "synth": _synth, "plan": _plan, "bench": _bench, "efd": _efd,
+COMMANDS = {"hands": _hands, "synth": _synth, "plan": _plan, "doctor": _doctor, "bench": _bench, "efd": _efd,
             "calibrate": _calibrate, "ros": _ros, "hand-from-model": _hand_from_model}
 
 

@@ -493,3 +493,19 @@ NEIGHBOUR_LIFT = 0.02
 MAX_TRIALS = 1000
 MAX_BENCH_TRIALS = 100_000
 MAX_SEED = 2**31 - 1 - MAX_TRIALS
+
+# --- contourgrasp doctor: what looks wrong in a user's frame ---
+
+#: A missing reading within this many pixels of a depth jump of more than DOCTOR_EDGE_STEP (m) is the sensor's
+#: (a projector's shadow, a flying-pixel filter), not the scene's.
+DOCTOR_EDGE_PX = 3
+DOCTOR_EDGE_STEP = 0.02
+#: More of the depth missing than this share is flagged.
+DOCTOR_MAX_MISSING = 0.3
+#: Horizontal and vertical fields of view (deg) a depth camera has; outside, the intrinsics are probably another
+#: image size's.
+DOCTOR_FOV_DEG = (20.0, 130.0)
+#: A principal point further than this share of the image size from its centre is flagged.
+DOCTOR_CENTRE_SHARE = 0.15
+#: A colour-depth offset of more pixels than this on the target is flagged.
+DOCTOR_MAX_OFFSET_PX = 4

@@ -274,3 +274,48 @@ def draw_heights(ax, heights, plan: GraspPlan | None = None, fig: Figure | None 
     obstacles = f", obstacles up to {1e3 * heights.obstacle_max_height:.0f} mm" if heights.obstacles.any() else ""
     ax.set_title(f"height map ({1e3 * heights.cell:g} mm cells): object up to "
                  f"{1e3 * heights.max_height:.0f} mm{obstacles}", fontsize=10)
+
+
+def doctor_figure(diagnosis) -> Figure:
+    """What ``contourgrasp doctor`` saw (:class:`contourgrasp.doctor.Diagnosis`): the colour with every candidate
+    (green: wholly in view, grey: touching the border, yellow: the target) and the plan's fingers; the depth with its
+    missing readings (red beside depth edges, magenta elsewhere); the heights above the support surface."""
+    fig = Figure(figsize=(21, 6.5), layout="constrained")
+    colour_ax, depth_ax, height_ax = fig.subplots(1, 3)
+    missing = diagnosis.missing
+    colour_ax.imshow(diagnosis.rgb if diagnosis.rgb is not None else ~missing, cmap="gray")
+    support, result = diagnosis.support, diagnosis.result
+    target = None if result is None or result.target is None else result.target.label
+    for c in () if support is None else support.candidates:
+        outline = np.vstack([c.contour_px, c.contour_px[:1]])
+        colour = "yellow" if c.label == target else "lime" if c.in_view else "0.6"
+        colour_ax.plot(*outline.T, color=colour, lw=2.0 if c.label == target else 1.0)
+        colour_ax.annotate(str(c.label), c.centroid_px, color=colour, fontsize=9, ha="center")
+    if result is not None:
+        for i, (finger, contact) in enumerate(zip(result.plan.hand.fingers, result.plan.fingers)):
+            path = _to_pixels(result, to_image(finger.points(np.linspace(0, finger.travel, 30)), result.plan.pose))
+            colour_ax.plot(*path.T, color=FINGER_COLOURS[i % len(FINGER_COLOURS)], lw=1.5,
+                           ls="--" if contact.missed else "-")
+    colour_ax.set_title("colour: candidates (green: in view, grey: at the border, yellow: the target)")
+    valid = np.where(missing, np.nan, 0.0)
+    depth_ax.imshow(valid, cmap="gray")
+    shown = np.zeros((*missing.shape, 4))
+    shown[missing & ~diagnosis.edge_missing] = (1.0, 0.0, 1.0, 0.8)
+    shown[diagnosis.edge_missing] = (1.0, 0.0, 0.0, 0.9)
+    depth_ax.imshow(shown)
+    depth_ax.set_title(f"missing depth {100 * missing.mean():.0f} % (red: beside depth edges)")
+    if support is not None:
+        plane = support.plane
+        inliers = plane.inliers if plane.inliers.shape == missing.shape else np.zeros_like(missing)
+        heights = np.full(missing.shape, np.nan)
+        for c in support.candidates:
+            heights[c.mask] = c.height
+        image = height_ax.imshow(np.where(inliers, 0.0, heights), cmap="viridis", vmin=0.0)
+        fig.colorbar(image, ax=height_ax, shrink=0.8, label="candidate height above the support [m] (0: on it)")
+        height_ax.set_title(f"support surface, tilted {math.degrees(plane.tilt):.1f} deg")
+    else:
+        height_ax.set_title("no support surface found")
+    for ax in (colour_ax, depth_ax, height_ax):
+        ax.set_xticks([])
+        ax.set_yticks([])
+    return fig
