@@ -137,7 +137,7 @@ def test_bad_option_values_exit_2(capsys):
     (["synth"], "contourgrasp synth: error: the following arguments are required: --contour "
                 "(see contourgrasp synth --help)"),
     (["nope"], "contourgrasp: error: argument command: invalid choice: 'nope' (choose from 'hands', 'synth', 'plan', "
-               "'bench', 'calibrate', 'hand-from-model', 'ros', 'efd') (see contourgrasp --help)"),
+               "'doctor', 'bench', 'calibrate', 'hand-from-model', 'ros', 'efd') (see contourgrasp --help)"),
 ])
 def test_argument_errors_are_one_line_naming_help(capsys, argv, line):
     code, out, err = run(capsys, *argv)

@@ -630,34 +630,16 @@ def _calibrate(args) -> int:
     return EXIT_OK
 
 
-#: The files a frame folder's colour, depth and intrinsics are looked for in, in this order.
-FRAME_FILES = {"colour": ("color*.png", "colour*.png", "rgb*.png", "*color*.png", "*rgb*.png", "*.jpg"),
-               "depth": ("depth*.npy", "*depth*.npy", "depth*.png", "*depth*.png"),
-               "intrinsics": ("camera.yaml", "camera_info.yaml", "*.intr", "camera*.json", "intrinsics*", "*.yaml")}
-
-
-def _frame_files(folder: Path) -> tuple[Path, Path, Path]:
-    """The colour image, depth image and intrinsics file of a frame folder (:data:`FRAME_FILES`)."""
-    if not folder.is_dir():
-        raise InputError(f"{folder}: not a folder (give a folder holding one frame, or --rgb, --depth, --intrinsics)")
-    found = {}
-    for kind, patterns in FRAME_FILES.items():
-        found[kind] = next((p for pattern in patterns for p in sorted(folder.glob(pattern)) if p.is_file()), None)
-        if found[kind] is None:
-            raise InputError(f"{folder}: no {kind} file ({', '.join(patterns)})")
-    return found["colour"], found["depth"], found["intrinsics"]
-
-
 def _doctor(args) -> int:
     from .doctor import diagnose
-    from .io.camera_file import read_rgbd
+    from .io.camera_file import frame_files
 
     given = [args.rgb, args.depth, args.intrinsics]
     if any(given) and args.frames:
         raise InputError("give frame folders or --rgb, --depth and --intrinsics, not both")
     if any(given) and not (args.depth and args.intrinsics):
         raise InputError("doctor needs --depth and --intrinsics (and --rgb, if there is colour)")
-    frames = [tuple(given)] if any(given) else [_frame_files(Path(f)) for f in args.frames]
+    frames = [tuple(given)] if any(given) else [frame_files(Path(f)) for f in args.frames]
     if not frames:
         raise InputError("give a frame folder, or --rgb, --depth and --intrinsics")
     hand, options = load_hand(args.hand), load_planner(args.planner).options

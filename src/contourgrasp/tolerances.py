@@ -101,13 +101,27 @@ PLANE_SAMPLE = 2000
 MIN_PLANE_FRACTION = 0.2
 
 #: Planes tilted more than this from facing the camera are walls, not tables (rad).
-MAX_TABLE_TILT = _radians(60.0)
+MAX_TABLE_TILT = _radians(70.0)
 
 #: Above this tilt (rad) the contour is planned in the table's plane rather than the image plane.
 TILT_PLANE_THRESHOLD = _radians(2.0)
 
 #: Above this tilt (rad) a warning says the top-down assumption is stretched.
 TILT_WARN = _radians(20.0)
+
+# The object's footprint on the table (perception.object_footprint).
+#: Side of the table grid's cells (m).
+FOOTPRINT_CELL = 0.0005
+#: The seen points' footprints are joined by closing with a disc of this radius (m): a pixel's width on the table
+#: at 1 m with a 525 px focal length, twice over.
+FOOTPRINT_CLOSE = 0.004
+#: Above this tilt (rad) the footprint's hidden far side is completed by the object's visual hull
+#: (perception.segment_depth.hidden_side): a band h tan(tilt) behind an object of height h is hidden, 0.58 h at
+#: 30 deg; below it the top seen bounds the far side, and the hull would close the gaps between touching
+#: neighbours and the concavities in an object's own shadow.
+HIDDEN_SIDE_TILT = _radians(30.0)
+#: At most this many grid cells (a larger footprint gets coarser cells: the work a frame can ask for is bounded).
+FOOTPRINT_MAX_CELLS = 4_000_000
 
 # The support surface (perception.support): a table or a bin's floor.
 #: Planes considered, the dominant one included.

@@ -9,6 +9,7 @@ import pytest
 
 from contourgrasp.errors import PerceptionError
 from contourgrasp.perception import HeightMap, Plane, contour_to_metric, height_map, segment_depth
+from contourgrasp.perception.table import table_points
 from contourgrasp.tolerances import HEIGHT_MAP_CELL, MAX_HEIGHT_MAP_CELLS
 from perception_scenes import CAMERA, render
 
@@ -76,10 +77,11 @@ def test_unseen_cells_are_nan_and_bounded_by_the_line_of_sight():
     assert np.all(np.hypot(x[shadow] - centre[0], y[shadow] - centre[1]) > radius - CELL)
     bound = hm.conservative()
     assert np.isfinite(bound[hm.in_view]).all()
-    assert bound[shadow].min() >= 0.0 and bound[shadow].max() <= height + 2e-3
+    # Above the rim by at most the slack of a seen point and a surface anywhere in their cells: H 2 diagonals / r.
+    r = np.hypot(x[shadow], y[shadow])
+    assert bound[shadow].min() >= 0.0 and bound[shadow].max() <= height + 0.7 * 2 * math.sqrt(2) * CELL / r.min()
     # The line of sight over the rim falls as the shadow leaves the wall: the farthest shadow cells are bounded
     # well below the wall's height (the shadow is h r / (H - h) long; its far end is at the table).
-    r = np.hypot(x[shadow], y[shadow])
     assert bound[shadow][r > np.percentile(r, 90)].max() < 0.5 * height
     np.testing.assert_array_equal(bound[hm.seen], hm.heights[hm.seen])
 
@@ -96,8 +98,29 @@ def test_missing_readings_are_nan_and_outside_the_view_is_unbounded():
     assert not hm.in_view.all()
     bound = hm.conservative()
     assert np.isposinf(bound[~hm.in_view]).all()
-    # No seen cell could hide the strip: it is bounded by the map's highest seen height.
+    # No ray passes over the strip (it is the view's edge): it is bounded by the map's highest seen height.
     np.testing.assert_allclose(bound[(x < left) & hm.in_view], np.nanmax(hm.heights))
+
+
+def test_a_wide_hole_in_the_table_is_bounded_by_the_rays_on_either_side():
+    # 8 cm of table without readings beside a 5 cm box, seen 40 deg tilted. Its near edge is bounded by the
+    # line of sight over the seen table toward the camera (about 0); its far edge, beyond the reach of any
+    # occluder, by the rays that reached the table just beyond it -- at most H (gap + 2 cell diagonals) / r --
+    # not by the tallest thing in view.
+    depth, table, seg, metric, _ = scene(tilt_deg=40.0, centre=(0.0, 0.0))
+    v, u = np.indices(depth.shape)
+    xy = (table_points(CAMERA, table, v, u) - metric.origin) @ metric.R_camera_plane[:, :2]
+    hole = (xy[..., 0] > 0.04) & (xy[..., 0] < 0.10) & (xy[..., 1] > -0.14) & (xy[..., 1] < -0.06)
+    hm = height_map(np.where(hole, 0.0, depth), CAMERA, table, metric, seg.mask, margin=0.2)
+    assert hm.camera_xy[1] > 0.5  # the camera's foot: beyond the hole's near edge (y = -0.06)
+    x, y = cell_xy(hm)
+    inner = (x > 0.045) & (x < 0.095) & ~hm.seen
+    near, far = inner & (y > -0.065) & (y < -0.06), inner & (y > -0.14) & (y < -0.135)
+    assert near.sum() > 10 and far.sum() > 10
+    bound = hm.conservative()
+    assert bound[near].max() < 1e-3
+    r = np.hypot(x[far] - hm.camera_xy[0], y[far] - hm.camera_xy[1]).min()
+    assert bound[far].max() <= 0.7 * (0.005 + 2 * math.sqrt(2) * CELL) / r < 0.4 * hm.max_height
 
 
 def test_lookups_and_the_heights_of_points():

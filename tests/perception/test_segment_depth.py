@@ -8,7 +8,7 @@ import pytest
 from scipy import ndimage
 
 from contourgrasp.errors import SegmentationError
-from contourgrasp.perception import segment_depth
+from contourgrasp.perception import Plane, hidden_side, segment_depth
 from perception_scenes import CAMERA, render, render_footprint, iou
 
 
@@ -33,6 +33,23 @@ def test_footprint_is_where_the_object_stands(tilt_deg):
     truth = render_footprint(kind="box", tilt_deg=tilt_deg, radius=0.03, centre=(0.03, 0.02))
     assert iou(seg.mask, truth) > 0.95
     assert iou(seen, truth) < 0.9
+
+
+@pytest.mark.parametrize("tilt_deg", [45.0, 60.0])
+def test_an_oblique_view_gets_the_hidden_side_of_the_footprint(tilt_deg):
+    # A 10 cm tall can seen from 45-60 deg: its top and near side are seen, its far half is not. The rays over it
+    # bound the hidden side, the hull of what is seen closes it: the whole base, where the region seen covers
+    # less than half of it. The table beyond the can lies past the sensor's range (1.5 m): the can is still
+    # wholly in view (a reading beyond the range is behind what it borders).
+    depth, _, seen, _ = render(kind="cylinder", tilt_deg=tilt_deg, radius=0.04, height=0.10)
+    truth = render_footprint(kind="cylinder", tilt_deg=tilt_deg, radius=0.04)
+    assert (depth > 1.5).any()
+    seg = segment_depth(depth, CAMERA)
+    assert seg.on_table and iou(seg.mask, truth) > 0.9
+    assert iou(seen, truth) < 0.4
+    rows = np.nonzero(truth.any(axis=1))[0]
+    far_half = truth & (np.arange(truth.shape[0])[:, None] < rows.mean())  # the image's top: away from the camera
+    assert (seg.mask & far_half).sum() > 0.9 * far_half.sum()
 
 
 @pytest.mark.parametrize("footprint", [False, True])
@@ -83,3 +100,18 @@ def test_a_click_outside_the_image_is_refused():
     depth, _, _ = _tall_box_over_a_flat_one()
     with pytest.raises(SegmentationError, match=r"pixel \(9999, 5\) is outside"):
         segment_depth(depth, CAMERA, footprint=True, target_px=(9999, 5))
+
+
+@pytest.mark.parametrize("kind", ["box", "cylinder"])
+def test_the_hidden_side_is_the_visual_hull_as_tall_as_the_object(kind):
+    # Seen from 45 deg, a 6 cm box's or can's far side is hidden. The table points hidden behind it whose point
+    # 6 cm up still projects into its silhouette are where it may stand: within its base (a pixel's slack), and
+    # for the can the base's far part its top does not show.
+    depth, _, seen, normal = render(kind=kind, tilt_deg=45.0, radius=0.03, height=0.06)
+    plane = Plane(normal=normal, offset=0.7)
+    added = hidden_side(seen, CAMERA, plane, top=0.06)
+    base = render_footprint(kind=kind, tilt_deg=45.0, radius=0.03)
+    assert added.sum() > 50
+    assert (added & ~ndimage.binary_dilation(base, iterations=2)).sum() < 0.02 * added.sum()
+    hidden = base & seen  # the base's pixels that see the object, not the table
+    assert (added & hidden).sum() > 0.8 * hidden.sum()

@@ -1,6 +1,7 @@
 """Scene and rendering: geometry of the top-down and tilted cameras, noise, exact masks, plan_grasp on a rendered can."""
 
 import numpy as np
+from scipy.spatial import Delaunay
 import pytest
 
 import contourgrasp
@@ -141,7 +142,7 @@ def test_flat_parts_and_registration_against_exact_truth():
 @pytest.mark.parametrize("name", ["can", "case"])
 def test_a_plan_from_a_tilted_camera_lands_on_the_object(name):
     # End to end from a camera tilted 12.7 deg, with the sensor's noise: the hand approaches along the table's
-    # normal, its grasp centre over the object and its fingertip plane 1 cm below the object's top (the nearest
+    # normal, its grasp centre over the object (within its outline seen from above) and its fingertip plane 1 cm below the object's top (the nearest
     # raw reading would put it 4-7 mm higher: benchmarks/approach_depth.py).
     scene = build_scene(name, seed=0, camera=Camera(height=0.7))
     eye, R_world_camera = view = tilted_view(TILT, 0.7)
@@ -153,5 +154,5 @@ def test_a_plan_from_a_tilted_camera_lands_on_the_object(name):
     T_world_hand = T_world_camera @ plan.T_camera_hand
     assert np.degrees(np.arccos(-T_world_hand[2, 2])) < 1.0  # approach axis straight down
     centre = T_world_hand @ [*hand.grasp_centre, 0.0, 1.0]
-    assert np.linalg.norm(centre[:2] - scene.object_com()[:2]) < 0.03
+    assert Delaunay(scene.object_points()[:, :2]).find_simplex(centre[:2]) >= 0  # over the object's outline
     assert abs(T_world_hand[2, 3] - (scene.object_points()[:, 2].max() - 0.01)) < 0.003

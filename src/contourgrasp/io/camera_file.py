@@ -293,6 +293,31 @@ def _check_rigid(path, matrix) -> np.ndarray:
     return out
 
 
+#: The files a frame folder's colour, depth and intrinsics are looked for in, in this order.
+FRAME_FILES = {"colour": ("color*.png", "colour*.png", "rgb*.png", "*color*.png", "*rgb*.png", "*.jpg"),
+               "depth": ("depth*.npy", "*depth*.npy", "depth*.png", "*depth*.png"),
+               "intrinsics": ("camera.yaml", "camera_info.yaml", "*.intr", "camera*.json", "intrinsics*", "*.yaml")}
+
+
+def frame_files(folder) -> tuple[Path, Path, Path]:
+    """The colour image, depth image and intrinsics file of a folder holding one frame (:data:`FRAME_FILES`).
+
+    Raises
+    ------
+    InputError
+        Not a folder, or one of the three is not in it.
+    """
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise InputError(f"{folder}: not a folder (give a folder holding one frame, or --rgb, --depth, --intrinsics)")
+    found = {}
+    for kind, patterns in FRAME_FILES.items():
+        found[kind] = next((p for pattern in patterns for p in sorted(folder.glob(pattern)) if p.is_file()), None)
+        if found[kind] is None:
+            raise InputError(f"{folder}: no {kind} file ({', '.join(patterns)})")
+    return found["colour"], found["depth"], found["intrinsics"]
+
+
 def read_rgbd(rgb_path=None, depth_path=None, intrinsics_path=None, *, mask_path=None,
               depth_scale: float = DEPTH_SCALE) -> RGBDFrame:
     """Read the files of one frame and check their sizes agree.

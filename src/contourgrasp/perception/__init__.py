@@ -44,7 +44,7 @@ from .height_map import HeightMap, height_map
 from .metric import DEPTH_MODES, DepthMode, MetricContour, approach_depth, contour_to_metric
 from .options import PerceptionOptions
 from .region import Segmentation, mask_contour
-from .segment_depth import object_footprint, open_table_holes, segment_depth
+from .segment_depth import hidden_side, object_footprint, open_table_holes, segment_depth
 from .segment_rgb import segment_rgb
 from .segmentation import SEGMENT_METHODS, SegmentMethod, segment, segment_from_mask
 from .support import Support, find_support
@@ -54,6 +54,6 @@ __all__ = [
     "Candidate", "DEPTH_MODES", "DepthMode", "HeightMap", "Intrinsics", "MetricContour", "PerceptionError", "PerceptionOptions", "PerceptionWarning", "Plane",
     "SEGMENT_METHODS", "SegmentMethod", "Segmentation", "SegmentationError", "Support", "TARGET_RULES", "add_flat_parts", "approach_depth",
     "as_depth", "backproject", "choose_target", "colour_on_depth", "colour_offset", "contour_to_metric", "denoised_depth", "fill_depth_holes",
-    "cross_section", "find_candidates", "find_support", "fit_plane", "fit_table_plane", "hand_opening", "height_map", "low_part_candidate", "mask_contour", "object_footprint", "one_frame", "open_table_holes", "register_colour", "segment",
+    "cross_section", "find_candidates", "find_support", "fit_plane", "fit_table_plane", "hand_opening", "height_map", "hidden_side", "low_part_candidate", "mask_contour", "object_footprint", "one_frame", "open_table_holes", "register_colour", "segment",
     "segment_depth", "segment_from_mask", "segment_rgb", "valid_depth",
 ]

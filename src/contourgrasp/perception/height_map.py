@@ -43,14 +43,16 @@ Unseen cells
 A cell that no valid reading falls in is NaN, not 0: it is unknown, not table. Single empty cells
 between seen ones (where the pixels' spacing on a far or oblique surface exceeds a cell) are filled
 with the largest of their seen neighbours; what stays NaN is the occlusion shadow behind a tall
-object (on its side away from the camera), holes of missing readings, and cells outside the
-camera's view. The descent check must not take them as free space. :meth:`HeightMap.conservative`
-gives the bound it should use: an unseen cell in view was hidden by something between it and the
-camera, so its surface lies below the line of sight over that occluder; the bound is the highest
-such line over the seen cells on the way from the cell toward the camera's foot. Where no seen
-cell of the map could hide it (a hole in the readings, or the occluder outside the map) the bound
-is the map's largest seen height, and outside the camera's view it is +inf (a pose whose hand
-passes there is not checkable and should be refused).
+object (on its side away from the camera), holes of missing readings (speckle, a projector's
+shadow, a sensor's dropouts beside edges), and cells outside the camera's view. The descent check
+must not take them as free space, nor as the tallest possible wall. :meth:`HeightMap.conservative`
+bounds them by what the camera's rays show, from both sides along the line through the camera's
+foot: toward the camera, the line of sight over the seen cells on the way (a surface higher would
+have been seen over them); away from it, the rays that reached seen cells beyond (they passed over
+the cell). Behind a tall object both are the line of sight over its rim; across a hole in the
+table, about the table near either edge. Where neither reaches (a hole at the view's far edge)
+the bound is the map's largest seen height, and outside the camera's view +inf (a pose whose hand
+passes there is not checkable and is refused).
 
 For the descent check
 ---------------------
@@ -74,7 +76,7 @@ from ..errors import PerceptionError
 from ..tolerances import (HEIGHT_MAP_CELL, HEIGHT_MAP_MARGIN, HEIGHT_MAP_OBJECT_BAND, MAX_HEIGHT_MAP_CELL, MAX_HEIGHT_MAP_CELLS,
                           MAX_HEIGHT_MAP_MARGIN, MIN_HEIGHT, SENSOR_RANGE)
 from ._pixels import dilate
-from ._shadow_kernels import shadow_bounds
+from ._ray_kernels import ray_bounds, shadow_bounds
 from .camera import Intrinsics, as_depth, check_intrinsics, denoised_at, pixel_points_at, valid_depth
 from .metric import MetricContour
 from .table import Plane, heights as plane_heights
@@ -206,15 +208,20 @@ class HeightMap:
     def conservative(self) -> np.ndarray:
         """(ny, nx) float: the heights with every unseen cell replaced by an upper bound of its true height.
 
-        An unseen cell in view lies in the shadow of an occluder between it and the camera's foot:
-        the ray to its surface was stopped by a seen point at distance s from the cell on the way,
-        so with r the cell's distance from the camera's foot, H the camera's height and h the
-        occluder's height, the cell's surface is at most h - (H - h) s / (r - s), the line of sight
-        over the occluder. The bound is the largest of these over the seen cells on the way (at
-        least 0), each with the two points taken a cell's diagonal nearer each other, since
-        either may lie anywhere in its cell. An unseen cell
-        with no possible occluder in the map takes the map's largest seen height; a cell outside
-        the camera's view takes +inf.
+        With r the cell's distance from the camera's foot, H the camera's height and h a seen
+        cell's height at distance s along the line through the foot, the smaller of:
+
+        * toward the camera, the highest line of sight over the seen cells on the way,
+          h - (H - h) s / (r - s): a surface above it would have been seen (at least 0; none within
+          reach of the map's highest seen height: that height);
+        * away from the camera, the lowest ray that reached a seen cell beyond,
+          h + (H - h) s / (r + s): it passed over the cell.
+
+        Either takes the two points a cell's diagonal toward its own side, since either may lie
+        anywhere in its cell. The first assumes a hole is a shadow, speckle or a dropout beside an
+        edge -- a surface that would return a reading where seen; the second holds for any hole,
+        and is what bounds one wider than the first can reach. A cell outside the camera's view
+        takes +inf.
 
         Returns
         -------
@@ -236,23 +243,25 @@ class HeightMap:
         top = float(out[seen].max()) if seen.any() else 0.0
         out[~seen & ~self.in_view] = np.inf
         rows, cols = np.nonzero(~seen & self.in_view)
-        if not len(rows):
+        if not len(rows) or not seen.any():
+            out[rows, cols] = top
             return out
         xs, ys = self.centres()
         start = np.c_[xs[cols], ys[rows]]
         toward = self.camera_xy - start
         r = np.hypot(toward[:, 0], toward[:, 1])
         unit = toward / np.maximum(r, 1e-12)[:, None]
-        # Beyond s = top r / H (and the cells' diagonals) no seen height can hide the cell.
-        diagonal = math.sqrt(2.0) * self.cell
-        reach = np.minimum(r, max(top, 0.0) * r / self.camera_height + 2 * diagonal)
+        diagonal, origin, cell, height = math.sqrt(2.0) * self.cell, np.asarray(self.origin, dtype=float), \
+            float(self.cell), float(self.camera_height)
+        # Toward the camera: beyond s = top r / H (and the cells' diagonals) no seen height can hide the cell.
+        reach = np.minimum(r, max(top, 0.0) * r / height + 2 * diagonal)
         span = min(float(np.hypot(*self.shape)) * self.cell, float(reach.max()))
         steps = np.arange(1, int(math.ceil(2 * span / self.cell)) + 1) * (0.5 * self.cell)  # half cells: no cell skipped
-        # The occluder's point and the cell's surface may lie anywhere in their cells: the bound takes
-        # them a cell's diagonal nearer each other (which only raises it).
-        bound = shadow_bounds(self.heights, start, unit, r, reach, steps, np.asarray(self.origin, dtype=float),
-                              float(self.cell), float(self.camera_height), diagonal, top)
-        out[rows, cols] = np.where(bound > -MIN_HEIGHT, np.maximum(bound, 0.0), top)
+        shadow = shadow_bounds(self.heights, start, unit, r, reach, steps, origin, cell, height, diagonal, top)
+        shadow = np.where(shadow > -MIN_HEIGHT, np.maximum(shadow, 0.0), top)
+        across = np.arange(1, int(math.ceil(2 * np.hypot(*self.shape))) + 1) * (0.5 * self.cell)
+        rays = ray_bounds(self.heights, start, -unit, r, across, origin, cell, height, diagonal, float(out[seen].min()))
+        out[rows, cols] = np.minimum(shadow, np.maximum(rays, 0.0))
         return out
 
 

@@ -20,7 +20,7 @@ from ..errors import PerceptionError, PerceptionWarning, SegmentationError
 from ..tolerances import APPROACH_OFFSET, MIN_RAY_COSINE, PLANE_THRESHOLD, SENSOR_RANGE, TILT_PLANE_THRESHOLD, TILT_WARN
 from ._pixels import connected_to, in_image
 from .camera import Intrinsics, as_depth, check_intrinsics, denoised_at, pixel_points, pixel_points_at, valid_depth
-from .table import IMAGE_PLANE, Plane, fit_table_plane, footprint_pixels, heights
+from .table import IMAGE_PLANE, Plane, fit_table_plane, footprint_pixels, heights, plane_axes
 
 
 DepthMode = Literal["max", "plane"]
@@ -265,7 +265,7 @@ def contour_to_metric(
         rows, cols = np.nonzero(inside & valid)
         heights = reference.height(pixel_points(d, intrinsics, rows, cols))
         level = heights[outline[rows, cols]].min() if depth_mode == "max" else heights.max()
-    rotation = _plane_frame(reference.normal)
+    rotation = plane_axes(reference.normal)
     origin, xy = _intersect(rays, reference, float(level), rotation)
     nearest = pixel_points_at(denoised_at(d, valid, rows, cols), intrinsics, rows, cols) @ rotation[:, 2]
     return MetricContour(
@@ -309,14 +309,6 @@ def _table_or_none(depth, intrinsics, depth_range):
             f"{err}: assuming the image plane is parallel to the table (thesis chapter 3)", PerceptionWarning, stacklevel=3
         )
         return None
-
-
-def _plane_frame(normal) -> np.ndarray:
-    """(3, 3): columns x, y, z of a frame with z = -normal and x along the camera's x projected on the plane."""
-    z = -np.asarray(normal, dtype=float)
-    x = np.array([1.0, 0.0, 0.0]) - z[0] * z
-    x /= np.linalg.norm(x)
-    return np.column_stack([x, np.cross(z, x), z])
 
 
 def _intersect(rays, plane, level, rotation):

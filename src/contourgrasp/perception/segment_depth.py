@@ -7,7 +7,7 @@ what is lower than ``min_height`` (a flat part), which
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 
 import cv2
 import numpy as np
@@ -15,13 +15,13 @@ from scipy import ndimage
 
 from .. import validation
 from ..errors import PerceptionError
-from ..tolerances import (MAX_HOLE_PX, MIN_AREA_PX, MIN_HEIGHT, MIN_TABLE_HOLE_PX, PLANE_THRESHOLD, SENSOR_RANGE,
+from ..tolerances import (FOOTPRINT_CELL, HIDDEN_SIDE_TILT, FOOTPRINT_CLOSE, FOOTPRINT_MAX_CELLS, MAX_HOLE_PX, MIN_AREA_PX, MIN_HEIGHT, MIN_TABLE_HOLE_PX, PLANE_THRESHOLD, SENSOR_RANGE,
                           TILT_PLANE_THRESHOLD)
 from ._frame import memoised
-from ._pixels import check_pixel, disc, grown_box, in_image
-from .camera import Intrinsics, as_depth, check_intrinsics, fill_depth_holes, valid_depth
+from ._pixels import check_pixel, disc, grown_box, in_image, pixel_box
+from .camera import Intrinsics, as_depth, check_intrinsics, fill_depth_holes, pixel_points, valid_depth
 from .region import Segmentation, make_segmentation, pick_object
-from .table import Plane, fit_table_plane, footprint_pixels, heights
+from .table import Plane, fit_table_plane, footprint_pixels, heights, plane_axes, table_points
 
 
 def segment_depth(
@@ -157,9 +157,16 @@ def raised_pixels(depth, intrinsics: Intrinsics, plane: Plane, *, min_height: fl
         Valid pixels more than ``min_height`` above the plane, opened with a
         3 x 3 element to drop speckle.
     dead_band : (H, W) bool
-        Missing readings connected (8-neighbour) to the image border.
+        Missing readings connected (8-neighbour) to the image border: 0, NaN or nearer than the
+        range, where a part of the object may hide. Readings beyond the range (a floor behind the
+        table, 3 m away in a view at 60 deg) lie behind whatever they border, and are not in it.
     """
     valid = valid_depth(depth, depth_range)
+
+    def dead_band():
+        with np.errstate(invalid="ignore"):
+            beyond = np.isfinite(depth) & (depth > depth_range[1])
+        return _border_connected(~valid & ~beyond)
 
     def raised():
         with np.errstate(invalid="ignore"):
@@ -168,7 +175,7 @@ def raised_pixels(depth, intrinsics: Intrinsics, plane: Plane, *, min_height: fl
 
     lo_hi = tuple(map(float, depth_range))
     return (memoised(depth, ("raised", intrinsics, plane.key, float(min_height), lo_hi), raised),
-            memoised(depth, ("dead band", lo_hi), lambda: _border_connected(~valid)))
+            memoised(depth, ("dead band", lo_hi), dead_band))
 
 
 def open_specks(above) -> np.ndarray:
@@ -258,19 +265,38 @@ def open_table_holes(mask, depth, intrinsics: Intrinsics, plane: Plane, *, min_p
 def object_footprint(mask, depth, intrinsics: Intrinsics, plane: Plane) -> np.ndarray:
     """Where the table holds what ``mask`` sees: the object's outline as a top-down view measures it.
 
-    Every valid pixel of ``mask`` is back-projected, moved along the table's
-    normal onto the table and projected back into the image
-    (the rounded pixels they fall on); the hit pixels are closed with a 5 x 5 disc,
-    which joins the samples that the object's steep sides spread apart (holes
-    are left to the caller, e.g. :func:`segment_depth`'s object picking).
-
     A camera that is not top-down sees a tall object's top displaced from its
     base, by height x sin(tilt) / depth x f pixels (8 px for 5 cm at 0.7 m,
-    12.7 deg, f = 525 px), and sees its near side as well; a top-down camera
-    sees the top enlarged by depth / (depth - height). The footprint undoes
-    both: it is where the object stands, the outline a hand approaching along
-    the table's normal closes on, and on the shared PrimeSense frames it is
-    nearer to the hand-made masks than the region seen above the table
+    12.7 deg, f = 525 px), sees its near side as well, and does not see its far
+    side; a top-down camera sees the top enlarged by depth / (depth - height).
+    The footprint undoes the first two and bounds the third:
+
+    1. Every valid pixel of ``mask`` is back-projected and moved along the
+       table's normal onto the table, into a grid of ``FOOTPRINT_CELL`` (0.5 mm)
+       cells on the table; the cells hit are closed with a disc of
+       ``FOOTPRINT_CLOSE`` (4 mm), which joins the samples that steep sides
+       spread apart, their holes are filled, and they are grown by half a
+       pixel's width on the table (the outermost points seen lie up to a
+       pixel inside the object's edge): the *seen footprint*. Where the top
+       is seen (most objects, at most tilts), its outline bounds the far side.
+    2. Above ``HIDDEN_SIDE_TILT`` (30 deg) much of the far side is hidden, and
+       holes in the readings (40 % of a 62 deg RealSense frame) leave the seen
+       footprint open there: the table points hidden behind the object that lie
+       in its visual hull, as tall as it is seen, are added
+       (:func:`hidden_side`). A mug at 62 deg whose far wall returned no
+       readings is whole. Below that tilt the top seen bounds the far side,
+       and the hull would close the hidden gap between touching neighbours and
+       the concavities in an object's own shadow (between a tool's head and
+       handle): the rule is not applied.
+    3. The footprint is drawn into the image: the pixels whose rays meet the
+       table in it.
+
+    What the footprint leaves out stays unknown to the planner: the height map bounds it by the
+    camera's rays (:meth:`~contourgrasp.perception.HeightMap.conservative`).
+
+    It is where the object stands, the outline a hand approaching along the
+    table's normal closes on, and on the shared PrimeSense frames it is nearer
+    to the hand-made masks than the region seen above the table
     (``benchmarks/segmentation.py``, docs/perception.md).
 
     Parameters
@@ -288,11 +314,105 @@ def object_footprint(mask, depth, intrinsics: Intrinsics, plane: Plane) -> np.nd
     -------
     (H, W) bool
     """
-    rows, cols = np.nonzero(mask & valid_depth(depth))
-    seen, u, v = in_image(footprint_pixels(depth, intrinsics, plane, rows, cols), mask.shape)
-    hit = np.zeros(mask.shape, dtype=np.uint8)
-    hit[v[seen], u[seen]] = 1
-    return cv2.morphologyEx(hit, cv2.MORPH_CLOSE, disc(2)) > 0
+    valid = valid_depth(depth)
+    rows, cols = np.nonzero(mask & valid)
+    out = np.zeros(mask.shape, dtype=bool)
+    if not len(rows):
+        return out
+    axes = plane_axes(plane.normal)[:, :2]
+    points = pixel_points(depth, intrinsics, rows, cols)
+    grid = _TableGrid.around((points - plane.height(points)[:, None] * plane.normal) @ axes)
+    seen = grid.raster(spacing=float(np.median(points[:, 2])) / intrinsics.fx)
+    box = _image_box(grid, axes, plane, intrinsics, mask)
+    prow, pcol = np.mgrid[box]
+    inside, i, j = grid.cells(table_points(intrinsics, plane, prow, pcol) @ axes)
+    out[box] = inside & seen[i, j]
+    if plane.tilt > HIDDEN_SIDE_TILT:
+        out |= hidden_side(mask, intrinsics, plane, top=float(np.percentile(plane.height(points), 95)))
+    return out
+
+
+def hidden_side(mask, intrinsics: Intrinsics, plane: Plane, *, top: float) -> np.ndarray:
+    """(H, W) bool: the pixels of ``mask`` whose rays meet the table where the object may stand, unseen.
+
+    The table behind an object is seen by no ray: a ray through a pixel of ``mask`` meets the object
+    first, and the table point T where it would have met the table is hidden. T is taken as object
+    when the point ``top`` (m) above it -- the object's highest seen height -- projects into ``mask``
+    too: the object's visual hull, as tall as it is seen (a lower column there would be allowed as
+    well; a taller one would have been seen above the silhouette). Behind a mug seen at 62 deg that is
+    its base's far half, up to where its far rim meets the silhouette's edge; behind a box or a lying
+    bottle, whose far top edge is the silhouette's, it is nothing.
+
+    Parameters
+    ----------
+    mask : (H, W) bool
+        The pixels that see the object.
+    intrinsics : Intrinsics
+    plane : Plane
+        The table.
+    top : float
+        The object's height, m.
+    """
+    rows, cols = np.nonzero(mask)
+    raised = table_points(intrinsics, plane, rows, cols) + top * plane.normal
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ok, u, v = in_image(intrinsics.project(raised), mask.shape)
+    ok[ok] = mask[v[ok], u[ok]]
+    out = np.zeros(mask.shape, dtype=bool)
+    out[rows[ok], cols[ok]] = True
+    return out
+
+
+@dataclass(frozen=True)
+class _TableGrid:
+    """Cells of side ``cell`` (m) on the table, from ``origin`` (2,), holding the footprints ``xy`` (n, 2)."""
+
+    xy: np.ndarray
+    origin: np.ndarray
+    cell: float
+    shape: tuple
+
+    @classmethod
+    def around(cls, xy):
+        margin = 2 * FOOTPRINT_CLOSE
+        lo, hi = xy.min(axis=0) - margin, xy.max(axis=0) + margin
+        cell = max(FOOTPRINT_CELL, float(np.sqrt(np.prod(hi - lo) / FOOTPRINT_MAX_CELLS)))
+        shape = tuple(int(n) for n in np.ceil((hi - lo) / cell)[::-1] + 1)  # (rows: y, cols: x)
+        return cls(xy, lo, cell, shape)
+
+    def cells(self, xy):
+        """Which of the (..., 2) points lie in the grid, and their cells' rows and columns (0 outside)."""
+        ij = np.floor((xy - self.origin) / self.cell)
+        inside = np.isfinite(ij).all(axis=-1)
+        ij = np.where(inside[..., None], ij, 0).astype(int)
+        inside &= (ij >= 0).all(axis=-1) & (ij[..., 1] < self.shape[0]) & (ij[..., 0] < self.shape[1])
+        ij[~inside] = 0
+        return inside, ij[..., 1], ij[..., 0]
+
+    def raster(self, *, spacing: float) -> np.ndarray:
+        """(rows, cols) bool: the cells hit, closed, with their holes filled and grown by half the pixels'
+        ``spacing`` (m): the outermost points seen lie up to a pixel inside the object's edge, half on average."""
+        hit = np.zeros(self.shape, dtype=np.uint8)
+        _, i, j = self.cells(self.xy)
+        hit[i, j] = 1
+        radius = max(1, int(round(FOOTPRINT_CLOSE / self.cell)))
+        closed = ndimage.binary_fill_holes(cv2.morphologyEx(hit, cv2.MORPH_CLOSE, disc(radius)) > 0)
+        grow = int(round(0.5 * spacing / self.cell))
+        return cv2.dilate(closed.astype(np.uint8), disc(grow)) > 0 if grow else closed
+
+
+def _image_box(grid, axes, plane, intrinsics, mask):
+    """(rows, cols) slices of the image that can see the grid: the box of its corners' pixels and of ``mask``
+    (the whole image when a corner is not in front of the camera)."""
+    (h, w), lo = grid.shape, grid.origin
+    corners = -plane.offset * plane.normal + (lo + np.array([[0, 0], [w, 0], [0, h], [w, h]]) * grid.cell) @ axes.T
+    if np.any(corners[:, 2] <= 0):
+        return np.s_[:, :]
+    u, v = intrinsics.project(corners).T
+    rows, cols = np.nonzero(mask)
+    rows = np.r_[rows, np.clip(v, -1, mask.shape[0]).astype(int)]
+    cols = np.r_[cols, np.clip(u, -1, mask.shape[1]).astype(int)]
+    return pixel_box(rows, cols, 1, mask.shape)
 
 
 def _border_connected(missing) -> np.ndarray:

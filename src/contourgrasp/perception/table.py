@@ -282,6 +282,27 @@ def footprint_pixels(depth, intrinsics: Intrinsics, plane: Plane, rows, cols) ->
         return intrinsics.project(on_table)
 
 
+def plane_axes(normal) -> np.ndarray:
+    """(3, 3): columns x, y, z of a frame with z = -normal and x along the camera's x projected on the plane.
+
+    The planning frame of a tilted camera (:func:`~contourgrasp.perception.contour_to_metric`) and the
+    footprint's grid (:func:`~contourgrasp.perception.object_footprint`)."""
+    z = -np.asarray(normal, dtype=float)
+    x = np.array([1.0, 0.0, 0.0]) - z[0] * z
+    x /= np.linalg.norm(x)
+    return np.column_stack([x, np.cross(z, x), z])
+
+
+def table_points(intrinsics: Intrinsics, plane: Plane, rows, cols) -> np.ndarray:
+    """(..., 3) float: where the rays of pixels (rows, cols) meet ``plane``; NaN where they miss it (behind the camera)."""
+    rays = np.stack([(cols - intrinsics.cx) / intrinsics.fx, (rows - intrinsics.cy) / intrinsics.fy,
+                     np.ones(np.shape(rows))], axis=-1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        reach = -plane.offset / (rays @ plane.normal)
+    reach = np.where(reach > 0, reach, np.nan)
+    return reach[..., None] * rays
+
+
 def median_heights(height) -> np.ndarray:
     """(H, W) float32: ``height`` median-filtered over 5 x 5 pixels: the noise cut about fivefold, a part's edge kept."""
     return cv2.medianBlur(np.ascontiguousarray(height, dtype=np.float32), 5)
