@@ -9,7 +9,9 @@ onto the depth grid) and planned with the default planner and hand (``--planner 
 - the outcome: planned (and how many fingers touch), or the reason of the refusal;
 - the target against the frame's truth, where the source gives one. The target's *seen* region (the
   chosen candidate's mask, the pixels that see it; a tilted camera plans on its footprint, which no
-  source labels) is compared with:
+  source labels), moved into the colour image by the colour-depth shift perception measured
+  (``Segmentation.colour_offset_px``: the sources label their colour images, and their depth lies a
+  few pixels off them), is compared with:
 
   * ``seg.png`` (one label per object): the label it overlaps most, the IoU with it, and the share
     of the target on that one label ("one object" when at least ``ONE_OBJECT`` of it is);
@@ -87,6 +89,19 @@ def truth_columns(folder: Path, seen: np.ndarray | None) -> str:
     return "no truth"
 
 
+def in_colour(mask, offset):
+    """``mask`` (depth pixels) moved into the colour image: the colour image moved by ``offset`` (dx, dy) lies on
+    the depth image, so the depth image's pixels lie at minus it in the colour image."""
+    if offset is None:
+        return mask
+    dx, dy = offset
+    moved = np.zeros_like(mask)
+    h, w = mask.shape
+    moved[max(-dy, 0):h + min(-dy, 0), max(-dx, 0):w + min(-dx, 0)] = mask[max(dy, 0):h + min(dy, 0),
+                                                                        max(dx, 0):w + min(dx, 0)]
+    return moved
+
+
 def iou(a, b) -> float:
     return float((a & b).sum() / max((a | b).sum(), 1))
 
@@ -116,7 +131,7 @@ def run(folder: Path, hand, options, runs: int, clock) -> tuple[str, ...]:
     else:
         touching = sum(not f.missed for f in result.plan.fingers)
         outcome = f"planned, {touching}/{len(result.plan.fingers)} fingers touch"
-        seen = None if result.target is None else result.target.mask
+        seen = None if result.target is None else in_colour(result.target.mask, result.segmentation.colour_offset_px)
     tilt = "-" if result is None or result.support is None else f"{np.degrees(result.support.plane.tilt):.0f}"
     return (folder.name, f"{depth.shape[1]}x{depth.shape[0]}", tilt, outcome, truth_columns(folder, seen),
             f"{statistics.median(times):.0f}")
