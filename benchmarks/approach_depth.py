@@ -62,7 +62,7 @@ def main(argv=None) -> int:
                 scene = build_scene(name, seed=seed, camera=CAMERA)
                 view = tilted_view(np.radians(tilt), CAMERA.height)
                 errors["exact"].append(height_error(scene, view, *render(scene, view=view)))
-                noisy = render(scene, noise=True, seed=seed, view=view)
+                noisy = render(scene, sensor="basic", seed=seed, view=view)
                 with mock.patch.object(perception.camera, "denoised_depth", lambda depth, valid: depth):
                     errors["raw"].append(height_error(scene, view, *noisy))
                 errors["filtered"].append(height_error(scene, view, *noisy))

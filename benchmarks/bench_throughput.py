@@ -40,7 +40,7 @@ def stages(setup: bench.Bench) -> dict[str, list[float]]:
         scene = build_scene(setup.objects[index], seed=seed, hand=setup.hand, camera=setup.camera,
                             workspace=setup.workspace)
         t1 = time.perf_counter()
-        rgb, depth = render(scene, noise=setup.noise, seed=seed)
+        rgb, depth = render(scene, sensor=setup.sensor, seed=seed)
         t2 = time.perf_counter()
         try:  # as run_trial calls a planner: the pose, the approach depth and, planned, the grasp height
             transform, approach_depth, *height = planner(rgb, depth, setup.camera.intrinsics)

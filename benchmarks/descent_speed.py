@@ -36,7 +36,7 @@ def frames(hand):
     yield "bar clamp (bundled)", (bundled.rgb, bundled.depth, bundled.intrinsics)
     for name in ("ycb:005_tomato_soup_can", "ycb:003_cracker_box", "ycb:025_mug"):
         scene = build_scene(load_object(name), seed=2, hand=hand)
-        yield name, (*render(scene, noise=True, seed=2), scene.camera.intrinsics)
+        yield name, (*render(scene, sensor="basic", seed=2), scene.camera.intrinsics)
 
 
 def median_ms(work) -> float:

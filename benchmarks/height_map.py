@@ -47,7 +47,7 @@ def accuracy(seeds: int) -> None:
                     scene = build_scene(soda_can(True) if name == "can-standing" else name, seed=seed,
                                         camera=Camera(height=0.7))
                     view = tilted_view(np.radians(tilt), 0.7) if tilt else None
-                    rgb, depth = render(scene, noise=noise, seed=seed, view=view)
+                    rgb, depth = render(scene, sensor="basic" if noise else "ideal", seed=seed, view=view)
                     with warnings.catch_warnings():
                         warnings.simplefilter("ignore")
                         seg, metric, _ = pipeline.perceive(rgb, depth, scene.camera.intrinsics)

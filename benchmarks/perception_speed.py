@@ -75,7 +75,7 @@ def sim_frames(seeds: int):
     for name in SIM_OBJECTS:
         for seed in range(seeds):
             scene = build_scene(name, seed=seed)
-            rgb, depth = render(scene, noise=True, seed=seed)
+            rgb, depth = render(scene, sensor="basic", seed=seed)
             yield f"sim {name} s{seed}", rgb, depth, scene.camera.intrinsics
 
 

@@ -49,7 +49,7 @@ RUNS, SEED = 5, 3
 def simulated_frame(obj: str, seed: int = SEED):
     """(rgb, depth, intrinsics) of the simulated frame of ``obj`` (a bench object name, e.g. ``ycb:025_mug``)."""
     scene = build_scene(load_object(obj), seed=seed)
-    return (*render(scene, noise=True, seed=seed), scene.camera.intrinsics)
+    return (*render(scene, sensor="basic", seed=seed), scene.camera.intrinsics)
 
 
 def frame_times(planner: str, frame, clock=time.perf_counter, runs: int = RUNS) -> tuple[float, float, float]:

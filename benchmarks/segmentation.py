@@ -15,7 +15,7 @@ luma), as a grayscale camera's driver stores it, against ``auto`` on colour.
 The rendered frames below are scored in grey too (:func:`print_simulated_grey`).
 
 A third table scores ``auto`` against exact truth, on frames the simulation
-renders (:func:`contourgrasp.sim.render`, with its depth noise) of the five
+renders (:func:`contourgrasp.sim.render`, with the bench's depth sensor, or ``--sensor``'s) of the five
 thesis objects and a dark grey tool with a flat plate
 (:func:`contourgrasp.sim.objects.flat_tool`), and the same tool in a yellow as
 light as the table in grey (``YELLOW``), ``--sim-seeds`` placements each,
@@ -31,7 +31,7 @@ aims at the first from a top-down camera and at the second from a tilted one
 A last table scores the scenes of several objects of the bench
 (:mod:`contourgrasp.sim.clutter`: ``clutter``, 2-4 YCB objects on the table,
 and ``bin``, 1-3 in a bin; the bench's SR300 camera, tilted 0-25 deg by the
-seed, its depth noise), ``--scene-seeds`` scenes per kind and YCB split, the
+seed, its depth sensor), ``--scene-seeds`` scenes per kind and YCB split, the
 target the seed's object of the split and its neighbours the split's others,
 as in ``contourgrasp bench --scene``. Per kind and split: the target's IoU
 when perception is given the target's pixel (:func:`contourgrasp.sim.target_pixel`,
@@ -54,7 +54,8 @@ IoU, with their scenes (seed, camera tilt, target, neighbours).
 
 Usage::
 
-    python benchmarks/segmentation.py [--data PATH] [--repeat N] [--sim-seeds N] [--scene-seeds N] [--worst N]
+    python benchmarks/segmentation.py [--data PATH] [--repeat N] [--sim-seeds N] [--scene-seeds N] [--sensor NAME]
+        [--worst N]
 
 ``--data`` defaults to ``$CONTOURGRASP_SHARED_DATA`` or ``../shared/data``
 beside the repository.
@@ -77,7 +78,7 @@ from contourgrasp import perception, pipeline
 from contourgrasp.errors import InputError
 from contourgrasp.io.camera_file import read_masked_frames
 from contourgrasp.perception import SegmentationError, register_colour, segment
-from contourgrasp.sim import (Camera, Intrinsics, build_clutter, build_scene, object_truth, render, target_pixel,
+from contourgrasp.sim import (DEFAULT_SENSOR, SENSORS, Camera, Intrinsics, build_clutter, build_scene, object_truth, render, target_pixel,
                               tilted_view, truth_labels)
 from contourgrasp.sim.objects import flat_tool
 from contourgrasp.tolerances import MIN_AREA_PX
@@ -133,7 +134,7 @@ def iou(a, b) -> float:
     return float((a & b).sum() / (a | b).sum())
 
 
-def simulated(seeds):
+def simulated(seeds, sensor):
     """Per (object, tilt), one row per seed: IoU of ``auto`` against the exact seen region and footprint,
     IoU of those two against each other, the colour shift ``auto`` found, and IoU of ``auto`` on the frame in
     grey (:func:`grey`) against its aim (the footprint when tilted, else the region seen)."""
@@ -143,7 +144,7 @@ def simulated(seeds):
             scene = build_scene(spec, seed=seed, camera=SIM_CAMERA)
             for tilt in SIM_TILTS_DEG:
                 view = tilted_view(np.radians(tilt), SIM_CAMERA.height)
-                rgb, depth = render(scene, noise=True, seed=seed, view=view)
+                rgb, depth = render(scene, sensor=sensor, seed=seed, view=view)
                 misregistered = register_colour(rgb, (-SIM_COLOUR_SHIFT[0], -SIM_COLOUR_SHIFT[1]))
                 seen, footprint = object_truth(scene, view)
                 with warnings.catch_warnings():
@@ -157,9 +158,9 @@ def simulated(seeds):
     return rows
 
 
-def print_simulated(seeds) -> None:
-    rows = simulated(seeds)
-    print(f"\nExact truth, rendered frames ({seeds} placements per object, the simulation's depth noise, colour "
+def print_simulated(seeds, sensor) -> None:
+    rows = simulated(seeds, sensor)
+    print(f"\nExact truth, rendered frames ({seeds} placements per object, the `{sensor}` depth sensor, colour "
           f"shifted by {SIM_COLOUR_SHIFT} px): IoU of auto, mean over placements (worst)\n")
     heads = [f"{tilt:g} deg vs {truth}" for tilt in SIM_TILTS_DEG for truth in ("seen", "footprint")]
     print("| object | " + " | ".join(heads) + " |")
@@ -206,7 +207,7 @@ SCENE_KINDS, SCENE_SPLITS = ("clutter", "bin"), ("ycb-train", "ycb-test")
 MATCH_IOU = 0.5
 
 
-def rendered_scenes(seeds):
+def rendered_scenes(seeds, sensor):
     """Per (kind, split), one (row, scene) pair per scene: the row is target IoU (0 when refused), refused,
     objects present, candidates found, objects matched by a candidate, target IoU in grey; the scene says
     which it is (seed, camera tilt, target and neighbours)."""
@@ -222,12 +223,12 @@ def rendered_scenes(seeds):
                 tilt = float(np.degrees(np.arccos(-scene.view[1][2, 2])))
                 about = (f"seed {seed}, tilt {tilt:.1f} deg: {target.name}"
                          + (f" beside {', '.join(o.name for o in scene.neighbours)}" if scene.neighbours else " alone"))
-                rows.setdefault((kind, split), []).append((_score_scene(scene, seed), about))
+                rows.setdefault((kind, split), []).append((_score_scene(scene, seed, sensor), about))
     return rows
 
 
-def _score_scene(scene, seed):
-    rgb, depth = render(scene, noise=True, seed=seed)
+def _score_scene(scene, seed, sensor):
+    rgb, depth = render(scene, sensor=sensor, seed=seed)
     intr = scene.camera.intrinsics
     labels = truth_labels(scene)
     seen, footprint = object_truth(scene)
@@ -261,18 +262,18 @@ def _ceiling(scene, seen, footprint) -> float:
     :func:`contourgrasp.pipeline.perceive` does): the best perception's footprint can score from a tilted
     camera, its segmentation perfect. What the camera cannot see (a bottle's base under its shoulders, the far side of a
     tall object) stays out of it."""
-    _, depth = render(scene, noise=False)
+    _, depth = render(scene, sensor="ideal")
     d = perception.as_depth(depth)
     intr = scene.camera.intrinsics
     return iou(perception.object_footprint(seen, d, intr, perception.find_support(d, intr).plane), footprint)
 
 
-def print_rendered_scenes(seeds, worst: int = 0) -> None:
+def print_rendered_scenes(seeds, sensor, worst: int = 0) -> None:
     """The scenes' table; with ``worst``, then each kind and split's ``worst`` targets of lowest IoU, one per line."""
-    scenes = rendered_scenes(seeds)
+    scenes = rendered_scenes(seeds, sensor)
     rows = {key: [scores for scores, _ in found] for key, found in scenes.items()}
-    print(f"\nScenes of several objects ({seeds} per kind and split, the bench's camera tilted 0-25 deg, its depth "
-          f"noise): the target given by its pixel, candidates against the objects present\n")
+    print(f"\nScenes of several objects ({seeds} per kind and split, the bench's camera tilted 0-25 deg, the `{sensor}` "
+          f"depth sensor): the target given by its pixel, candidates against the objects present\n")
     print(f"| scene | split | target IoU, mean (worst) | targets below {MATCH_IOU} | refused | objects present | "
           f"candidates found | objects found (IoU >= {MATCH_IOU}) | target IoU in grey, mean (worst) | "
           f"single view's ceiling, mean (worst) |")
@@ -297,6 +298,8 @@ def main(argv=None) -> int:
     parser.add_argument("--sim-seeds", type=int, default=3, help="placements per simulated object (0: none)")
     parser.add_argument("--scene-seeds", type=int, default=5,
                         help="scenes of several objects per kind and YCB split (0: none)")
+    parser.add_argument("--sensor", default=DEFAULT_SENSOR, choices=tuple(SENSORS),
+                        help="the simulated depth sensor of the rendered frames (default: %(default)s, the bench's)")
     parser.add_argument("--worst", type=int, default=0,
                         help="also list each kind and split's WORST targets of lowest IoU, with their scenes")
     args = parser.parse_args(argv)
@@ -307,9 +310,9 @@ def main(argv=None) -> int:
     else:
         print(f"no frames with segmask_N.png found under {args.data}/rgbd: real frames skipped", file=sys.stderr)
     if args.sim_seeds > 0:
-        print_simulated(args.sim_seeds)
+        print_simulated(args.sim_seeds, args.sensor)
     if args.scene_seeds > 0:
-        print_rendered_scenes(args.scene_seeds, args.worst)
+        print_rendered_scenes(args.scene_seeds, args.sensor, args.worst)
     return 0
 
 

@@ -385,7 +385,7 @@ def standing_can_frame():
     from contourgrasp.sim.scene import build_scene
 
     scene = build_scene(soda_can(standing=True), seed=3, hand="five-finger-linear")
-    rgb, depth = render(scene, noise=True, seed=3)
+    rgb, depth = render(scene, sensor="basic", seed=3)
     return rgb, depth, scene.camera.intrinsics
 
 
@@ -434,7 +434,7 @@ def test_the_small_object_rule_plans_a_strawberry_with_fewer_fingers():
 
     hand = cg.load_hand("five-finger-linear")
     scene = build_scene(ycb.load_object("ycb:012_strawberry"), seed=0, hand=hand)
-    rgb, depth = render(scene, noise=True, seed=0)
+    rgb, depth = render(scene, sensor="basic", seed=0)
     with pytest.raises(cg.NoFeasibleGrasp, match="4 fingers"):
         cg.plan_grasp(rgb, depth, scene.camera.intrinsics, hand, xy_step=0.01, yaw_step=0.1)
     result = cg.plan_grasp(rgb, depth, scene.camera.intrinsics, hand, small_objects=True, xy_step=0.01,
@@ -456,7 +456,7 @@ def test_fingertip_balls_plan_and_lift_a_block_narrower_than_the_points_reach():
     hand = cg.load_hand("five-finger-linear")
     block = ycb.load_object("ycb:070-b_colored_wood_blocks")
     scene = build_scene(block, seed=0, hand=hand)
-    rgb, depth = render(scene, noise=True, seed=0)
+    rgb, depth = render(scene, sensor="basic", seed=0)
     result = cg.plan_grasp(rgb, depth, scene.camera.intrinsics, hand, small_objects=True, descent=True,
                                  grasp_height="auto", xy_step=0.01, yaw_step=0.1)
     assert result.plan.grown == min(f.radius for f in hand.fingers)  # grown only when the points reach nothing
@@ -488,7 +488,7 @@ def test_a_tall_box_with_no_balanced_squeeze_on_its_outline_seen_is_planned_on_i
     hand = cg.load_hand("five-finger-linear")
     box = ycb.load_object("ycb:003_cracker_box")
     scene = build_scene(box, seed=4, hand=hand)
-    rgb, depth = render(scene, noise=True, seed=4)
+    rgb, depth = render(scene, sensor="basic", seed=4)
     options = dict(cg.load_planner("default").settings)
     seen = cg.plan_grasp(rgb, depth, scene.camera.intrinsics, hand, **(options | {"slice_contour": False}))
     assert not seen.plan.balanced and any("no pose balances" in n for n in seen.plan.notes)
@@ -524,7 +524,7 @@ def test_low_objects_plans_an_object_lower_than_the_threshold_as_a_pinch_and_a_t
     hand = cg.load_hand("five-finger-linear")
     options = {"descent": True, "grasp_height": "auto", "small_objects": True, "low_objects": True, "yaw_step": 0.1}
     scene = build_scene(flat_tool(), seed=0, hand=hand)  # its grip stands 24 mm
-    rgb, depth = render(scene, noise=True, seed=0)
+    rgb, depth = render(scene, sensor="basic", seed=0)
     low = cg.plan_grasp(rgb, depth, scene.camera.intrinsics, hand, **options)
     assert low.height_map.max_height < cg.tolerances.LOW_OBJECT_HEIGHT
     assert "a low object" in low.plan.notes[-1] and low.plan.grown == min(f.radius for f in hand.fingers)

@@ -92,7 +92,7 @@ def sim_contours(names=SIM_OBJECTS, seeds=range(3)) -> dict[str, list[np.ndarray
         out[name] = []
         for seed in seeds:
             scene = build_scene(name, seed=seed)
-            rgb, depth = render(scene, noise=True, seed=seed)
+            rgb, depth = render(scene, sensor="basic", seed=seed)
             out[name].append(perceive(rgb, depth, scene.camera.intrinsics)[1].contour_xy)
     return out
 

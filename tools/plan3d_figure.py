@@ -15,7 +15,7 @@ from contourgrasp.visualize import image_plan_figure
 def main(out: str = "docs/plan-3d.png") -> None:
     hand = load_hand("five-finger-linear")
     scene = build_scene(load_object("ycb:005_tomato_soup_can"), seed=0, hand=hand)
-    rgb, depth = render(scene, noise=True, seed=0)
+    rgb, depth = render(scene, sensor="basic", seed=0)
     result = pipeline.plan_frame(rgb, depth, scene.camera.intrinsics, hand, load_planner("default").options)
     image_plan_figure(result, rgb).savefig(out, dpi=60)
 

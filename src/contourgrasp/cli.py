@@ -105,6 +105,13 @@ def _non_negative_int(text: str) -> int:
     return _whole(text, 0, "an integer >= 0")
 
 
+def _tilt_degrees(text: str) -> float:
+    value = _whole(text, 0, "a whole number of degrees from 0 to 65") if text.strip().isdigit() else None
+    if value is None or value > 65:
+        raise argparse.ArgumentTypeError(f"must be a whole number of degrees from 0 to 65, got {_shown(text)}")
+    return float(value)
+
+
 def _names(text: str) -> list[str]:
     return [name.strip() for name in text.split(",") if name.strip()]
 
@@ -278,8 +285,13 @@ def _add_bench_parser(sub) -> None:
     bench.add_argument("--ablation", action="store_true",
                        help="also run every step of the ablation from paper to default")
     bench.add_argument("--out", help="output folder (created if missing; default bench-output)")
-    bench.add_argument("--noise", action=argparse.BooleanOptionalAction, default=True,
-                       help="depth sensor noise in the planner's picture")
+    bench.add_argument("--sensor", default="structured-light",
+                       help="the depth sensor of the planner's picture, how it fails (docs/bench.md, \"Sensors\"): "
+                            "ideal (exact depth), basic, structured-light, stereo, tof or industrial "
+                            "(default: %(default)s)")
+    bench.add_argument("--tilt", type=_tilt_degrees, metavar="DEG",
+                       help="the camera tilted DEG (0-65) from looking straight down, for every trial (default: "
+                            "top-down for single scenes, 0-25 deg by seed for clutter and bin)")
     bench.add_argument("--workers", type=_positive_int,
                        help="run the trials in this many processes (default: the number of cores; 1: in this one)")
     bench.add_argument("--ray", nargs="?", const="", metavar="ADDRESS",
@@ -569,8 +581,10 @@ def _bench(args) -> int:
     out = Path(args.resume or args.out or "bench-output")
     if out.exists() and not out.is_dir():
         raise OutputError(f"{out}: cannot write the bench's outputs into it, it is not a directory")
-    from .sim import bench, mesh_object
+    from .sim import SENSORS, bench, mesh_object
 
+    if args.sensor not in SENSORS:
+        raise InputError(f"--sensor must be one of {', '.join(SENSORS)}, got {shown(args.sensor)}")
     started = time.perf_counter()
     objects, splits = ([mesh_object(path, name=name) for path, name in zip(args.mesh, _mesh_names(args.mesh),
                                                                             strict=True)], ()) \
@@ -583,7 +597,8 @@ def _bench(args) -> int:
     mounted = _hand_model(args)
     hand = load_hand(args.hand or "five-finger-linear") if mounted is None else mounted.hand
     setup = bench.Bench(objects=objects, planners=planners, trials=args.trials, seed=args.seed, hand=hand,
-                        noise=args.noise, splits=splits, hand_model=mounted,
+                        sensor=args.sensor, tilt=None if args.tilt is None else math.radians(args.tilt),
+                        splits=splits, hand_model=mounted,
                         scene_kind=args.scene)
     journal, done = bench.resume(out, setup) if args.resume is not None else (None, ())
     with bench.executor(setup, workers=args.workers, ray=args.ray is not None, address=args.ray or None) as run:

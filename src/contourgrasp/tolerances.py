@@ -103,6 +103,9 @@ MIN_PLANE_FRACTION = 0.2
 #: Planes tilted more than this from facing the camera are walls, not tables (rad).
 MAX_TABLE_TILT = _radians(70.0)
 
+#: The bench's camera is tilted at most this far from looking straight down (rad): as oblique as a humanoid's head.
+MAX_BENCH_TILT = _radians(65.0)
+
 #: Above this tilt (rad) the contour is planned in the table's plane rather than the image plane.
 TILT_PLANE_THRESHOLD = _radians(2.0)
 

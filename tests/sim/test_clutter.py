@@ -59,7 +59,7 @@ def test_same_seed_same_settled_scene_and_no_interpenetration():
     a = build_clutter("case", CANS, kind="clutter", seed=3, settle=SETTLE)
     b = build_clutter("case", CANS, kind="clutter", seed=3, settle=SETTLE)
     np.testing.assert_array_equal(a.data.qpos, b.data.qpos)
-    np.testing.assert_array_equal(render(a, noise=True, seed=3)[1], render(b, noise=True, seed=3)[1])
+    np.testing.assert_array_equal(render(a, sensor="basic", seed=3)[1], render(b, sensor="basic", seed=3)[1])
     assert target_pixel(a) == target_pixel(b)
     bodies = {a.model.body("object").id, *(a.model.body(f"neighbour_{k}").id for k in range(len(a.neighbours)))}
     for contact in a.data.contact[: a.data.ncon]:

@@ -39,7 +39,7 @@ def sampled(request):
     name = request.param
     hand, simulated = (load_hand(name),) * 2 if name == "five-finger-linear" else _mounted(name)
     scene = build_scene(soda_can(standing=True), seed=3, hand=simulated)
-    rgb, depth = render(scene, noise=False)
+    rgb, depth = render(scene, sensor="ideal")
     planned = plan_grasp(rgb, depth, scene.camera.intrinsics, hand, xy_step=0.02, yaw_step=0.2)
     centre = planned.metric.contour_xy.mean(axis=0)
     rng = np.random.default_rng(7)

@@ -20,7 +20,7 @@ HAND = contourgrasp.load_hand("five-finger-linear")
 @pytest.mark.parametrize("baseline", ["centroid-principal-axis", "random"])
 def test_baselines_share_plan_grasps_perception(baseline):
     scene = build_scene("case", seed=3)
-    rgb, depth = render(scene, noise=True, seed=3)
+    rgb, depth = render(scene, sensor="basic", seed=3)
     camera = scene.camera.intrinsics
     planned = make_planner(baseline, HAND, seed=3).plan(rgb, depth, camera)
     reference = plan_frame(rgb, depth, camera, HAND)

@@ -6,7 +6,7 @@ import pytest
 
 import contourgrasp
 from contourgrasp import perception
-from contourgrasp.sim import (Camera, DepthNoise, build_scene, hand_pose_from_matrix, object_truth, render,
+from contourgrasp.sim import (SENSORS, Camera, build_scene, hand_pose_from_matrix, object_truth, render,
                               render_view, tilted_view)
 from contourgrasp.sim.objects import flat_tool
 from contourgrasp.sim.planners import make_planner
@@ -56,9 +56,9 @@ def test_depth_outside_the_sensor_range_is_missing():
 
 def test_noise_is_seeded_and_drops_edge_pixels(can_scene):
     _, exact = render(can_scene)
-    _, a = render(can_scene, noise=True, seed=5)
-    _, b = render(can_scene, noise=True, seed=5)
-    _, c = render(can_scene, noise=DepthNoise(), seed=6)
+    _, a = render(can_scene, sensor="basic", seed=5)
+    _, b = render(can_scene, sensor="basic", seed=5)
+    _, c = render(can_scene, sensor=SENSORS["basic"], seed=6)
     np.testing.assert_array_equal(a, b)
     assert not np.array_equal(a, c)
     table = (exact > can_scene.camera.height - 1e-3) & (a > 0)
@@ -76,7 +76,7 @@ def test_placement_is_seeded_and_inside_the_workspace():
 
 
 def test_planner_finds_the_can(can_scene):
-    rgb, depth = render(can_scene, noise=True, seed=1)
+    rgb, depth = render(can_scene, sensor="basic", seed=1)
     hand = contourgrasp.load_hand("five-finger-linear")
     transform, approach, height = make_planner("paper", hand)(rgb, depth, can_scene.camera.intrinsics)
     x, y, yaw = hand_pose_from_matrix(transform)
@@ -115,7 +115,7 @@ def test_object_truth_from_above(can_scene):
 def test_footprint_segmentation_matches_the_exact_footprint_of_a_tilted_view():
     scene = build_scene("can", seed=0, camera=Camera(height=0.7))
     view = tilted_view(TILT, 0.7)
-    rgb, depth = render(scene, noise=True, seed=0, view=view)
+    rgb, depth = render(scene, sensor="basic", seed=0, view=view)
     seen, footprint = object_truth(scene, view)
     result = perception.segment(rgb, depth, scene.camera.intrinsics)
     assert np.isclose(result.plane.tilt, TILT, atol=np.radians(0.5)) and result.on_table
@@ -131,7 +131,7 @@ def test_flat_parts_and_registration_against_exact_truth():
     # A dark grey tool whose plate depth cannot see, on the light table, colour misregistered by (1, -3) px.
     scene = build_scene(flat_tool(), seed=1, camera=Camera(height=0.7))
     view = tilted_view(TILT, 0.7)
-    rgb, depth = render(scene, noise=True, seed=1, view=view)
+    rgb, depth = render(scene, sensor="basic", seed=1, view=view)
     _, footprint = object_truth(scene, view)
     misregistered = perception.register_colour(rgb, (-1, 3))
     result = perception.segment(misregistered, depth, scene.camera.intrinsics)
@@ -146,7 +146,7 @@ def test_a_plan_from_a_tilted_camera_lands_on_the_object(name):
     # raw reading would put it 4-7 mm higher: benchmarks/approach_depth.py).
     scene = build_scene(name, seed=0, camera=Camera(height=0.7))
     eye, R_world_camera = view = tilted_view(TILT, 0.7)
-    rgb, depth = render(scene, noise=True, seed=0, view=view)
+    rgb, depth = render(scene, sensor="basic", seed=0, view=view)
     hand = contourgrasp.load_hand("five-finger-linear")
     plan = contourgrasp.plan_grasp(rgb, depth, scene.camera.intrinsics, hand=hand)
     T_world_camera = np.eye(4)

@@ -28,7 +28,8 @@ Example::
 from .tendon_hand import TIMINGS, ChainRule, FingerTiming, HandDesign, HandModel, build_hand, derive_body
 from .measure import fingertip_path_error, fingertip_paths
 from .objects import THESIS_OBJECTS, ObjectSpec, Part, mesh_object, object_spec
-from .render import BIN_LABEL, DepthNoise, object_truth, render, render_view, tilted_view, truth_labels
+from .render import (BIN_LABEL, DEFAULT_SENSOR, SENSORS, Sensor, object_truth, render, render_view, sensor_named,
+                     tilted_view, truth_labels)
 from ..perception import Intrinsics
 from .scene import SR300, Bin, Camera, Placement, Scene, Workspace, build_scene
 from .clutter import SCENE_KINDS, Arrangement, arrange, build_clutter, target_pixel
@@ -37,9 +38,9 @@ from .trial import (DROPPED, FAILURE_CAUSES, HIT, MISSED, NO_PLAN, PUSHED, SLIPP
 
 __all__ = [
     "Arrangement", "BIN_LABEL", "Bin", "HIT", "SCENE_KINDS", "arrange", "build_clutter", "target_pixel", "truth_labels",
-    "Camera", "ChainRule", "DROPPED", "DepthNoise", "Execution", "FAILURE_CAUSES", "FingerTiming", "GraspOutcome", "HandDesign",
+    "Camera", "ChainRule", "DEFAULT_SENSOR", "DROPPED", "SENSORS", "Sensor", "Execution", "FAILURE_CAUSES", "FingerTiming", "GraspOutcome", "HandDesign",
     "HandModel", "Intrinsics", "MISSED", "NO_PLAN", "ObjectSpec", "PUSHED", "Part", "Placement", "SLIPPED", "SR300", "STRUCK",
     "Scene", "THESIS_OBJECTS", "TIMINGS", "TrialRecord", "Workspace", "build_hand", "build_scene", "derive_body", "execute_grasp",
     "fingertip_path_error", "fingertip_paths", "hand_pose_from_matrix", "mesh_object", "object_spec", "object_truth",
-    "pose_matrix", "render", "render_view", "run_trial", "scripted_grasp", "tilted_view",
+    "pose_matrix", "render", "render_view", "run_trial", "scripted_grasp", "sensor_named", "tilted_view",
 ]

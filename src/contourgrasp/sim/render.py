@@ -5,11 +5,13 @@ the hit distance along a ray whose camera-frame direction has unit z is the
 depth along the optical axis directly. Colour is the hit geom's rgba, shaded by
 the cosine between its surface normal and the ray (a light at the camera).
 
-Depth noise (:class:`DepthNoise`) mimics a structured-light sensor such as the
-SR300: Gaussian noise growing with the square of the depth (~1.7 mm at
-0.65 m), readings missing at random along depth discontinuities (the projector
-and the camera do not see the same side of an edge), and nothing outside the
-sensor's range.
+The depth is that of a sensor (:class:`Sensor`, by preset name in :data:`SENSORS`), each a model of
+how a kind of depth camera fails, its statistics set from the shared real frames of that kind
+(``benchmarks/sensor_statistics.py``; docs/bench.md, "Sensors"): Gaussian noise growing with the
+square of the depth; readings missing along depth discontinuities; the shadow of a projector or a
+second camera beside raised edges (the points it cannot see read nothing); dropouts on dark
+surfaces; speckle holes; flying pixels between an edge's two sides; and nothing outside the
+sensor's range. ``ideal`` is exact depth.
 
 :func:`object_truth` gives the exact segmentation of a picture, for judging
 perception against it: the pixels that see the object, and the pixels that see
@@ -24,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import SimulationError
 from ..perception import Intrinsics
 from .scene import R_WORLD_CAMERA, Scene, mujoco
 
@@ -41,35 +44,101 @@ TRUTH_MARGIN = 0.05
 
 
 @dataclass(frozen=True)
-class DepthNoise:
-    """Sensor noise model.
+class Sensor:
+    """How a depth camera fails: the model :func:`render` applies to the exact depth.
 
     Attributes
     ----------
+    name : str
+    source : str
+        What its statistics come from, one line.
     sigma : float
         Standard deviation of the depth noise at 1 m, m; it scales with depth squared.
     edge_jump : float
         A pixel whose 3 x 3 neighbourhood spans more depth than this (m) lies on an edge.
     edge_dropout : float
         Probability that an edge pixel reads nothing.
+    shadow_baseline : float
+        A projector (structured light) or the second camera (active stereo) this far (m) along the camera's
+        +x axis: a point it cannot see reads nothing, a band beside every raised edge. 0: none.
+    dark_dropout : float
+        Probability that a pixel whose colour is darker than ``DARK`` reads nothing (light absorbed, or a
+        shiny surface's reflection missing the sensor).
+    speckle : float
+        Share of the image in holes of missing readings scattered at random, ``SPECKLE_PX`` across.
+    flying : float
+        Probability that an edge pixel reads a depth between its neighbourhood's nearest and farthest
+        (a time-of-flight pixel mixing the two sides of an edge).
     """
 
-    sigma: float = 0.004
+    name: str
+    source: str = ""
+    sigma: float = 0.0
     edge_jump: float = 0.01
-    edge_dropout: float = 0.5
+    edge_dropout: float = 0.0
+    shadow_baseline: float = 0.0
+    dark_dropout: float = 0.0
+    speckle: float = 0.0
+    flying: float = 0.0
+
+    @property
+    def ideal(self) -> bool:
+        """Whether the depth is left exact."""
+        return not any((self.sigma, self.edge_dropout, self.shadow_baseline, self.dark_dropout, self.speckle,
+                        self.flying))
 
 
-def render(scene: Scene, *, noise: DepthNoise | bool = False, seed: int = 0,
+#: A pixel darker than this (mean of its rgb, 0-255) is dark (:attr:`Sensor.dark_dropout`).
+DARK = 50
+#: Speckle holes are about this wide, px.
+SPECKLE_PX = 3
+#: A point is in the projector's shadow when something lies more than this (m) before it on the projector's ray.
+SHADOW_SLACK = 0.002
+
+#: The sensor presets, by name. Statistics from ``benchmarks/sensor_statistics.py`` on the shared real frames;
+#: the time-of-flight preset, whose sensor the shared frames lack, from its published behaviour.
+SENSORS: dict[str, Sensor] = {s.name: s for s in (
+    Sensor("ideal", "exact depth"),
+    Sensor("basic", "Gaussian noise and random edge dropouts: the bench's camera before the presets",
+           sigma=0.004, edge_dropout=0.5),
+    Sensor("structured-light", "SR300 / PrimeSense: the projector 5 cm beside the camera casts a shadow beside "
+           "raised edges, dark surfaces drop out; noise, edge dropouts and speckle of the SR300 bin frame",
+           sigma=0.006, edge_dropout=0.9, shadow_baseline=0.05, dark_dropout=0.3, speckle=0.01),
+    Sensor("stereo", "RealSense D4xx: the second camera 5 cm away leaves an invalid band on one side of objects, "
+           "noise grows with depth squared; the three RealSense frames' statistics",
+           sigma=0.0025, edge_dropout=0.2, shadow_baseline=0.05, speckle=0.0005),
+    Sensor("tof", "Kinect v2 time of flight: flying pixels and dropouts at edges, speckle holes (its published "
+           "behaviour: no shared frame is of one)", sigma=0.002, edge_dropout=0.2, flying=0.5, speckle=0.005,
+           dark_dropout=0.1),
+    Sensor("industrial", "PhoXi / Ensenso industrial structured light: low noise, the projector's shadow; the "
+           "PhoXi bin frame's edge dropouts", sigma=0.001, edge_dropout=0.9, shadow_baseline=0.1),
+)}
+#: The bench's sensor by default.
+DEFAULT_SENSOR = "structured-light"
+
+
+def sensor_named(sensor) -> Sensor:
+    """``sensor`` itself, a preset of :data:`SENSORS` by name, or for a bool the ``basic`` preset (True) or ``ideal``."""
+    if isinstance(sensor, Sensor):
+        return sensor
+    if isinstance(sensor, (bool, np.bool_)):
+        return SENSORS["basic" if sensor else "ideal"]
+    if isinstance(sensor, str) and sensor in SENSORS:
+        return SENSORS[sensor]
+    raise SimulationError(f"unknown sensor {sensor!r}: choose one of {', '.join(SENSORS)}")
+
+
+def render(scene: Scene, *, sensor: Sensor | str | bool = False, seed: int = 0,
            show_hand: bool = False, view=None) -> tuple[np.ndarray, np.ndarray]:
     """Render the scene from its camera (or from ``view``, with the camera's intrinsics).
 
     Parameters
     ----------
     scene : Scene
-    noise : DepthNoise or bool
-        ``True`` for the default :class:`DepthNoise`; ``False`` for exact depth.
+    sensor : Sensor, str or bool
+        A :class:`Sensor` or the name of one of :data:`SENSORS`; ``True`` is ``"basic"``, ``False`` ``"ideal"``.
     seed : int
-        Seeds the noise.
+        Seeds the sensor's noise.
     show_hand : bool
         Draw the hand too (for figures; the planner's picture is taken without it).
     view : (eye, R_world_camera), optional
@@ -85,9 +154,11 @@ def render(scene: Scene, *, noise: DepthNoise | bool = False, seed: int = 0,
     """
     depth_min, depth_max = scene.camera.depth_range
     eye, R_world_camera = _view(scene, view)
+    sensor = sensor_named(sensor)
     rgb, depth, _ = _cast(scene, eye, R_world_camera, scene.camera.intrinsics, show_hand, 2 * depth_max)
-    if noise:
-        depth = _noisy(depth, DepthNoise() if noise is True else noise, np.random.default_rng([seed, 1]))
+    if not sensor.ideal:
+        shadow = _shadowed(scene, eye, R_world_camera, depth, sensor.shadow_baseline) if sensor.shadow_baseline else None
+        depth = _sensed(depth, rgb, shadow, sensor, np.random.default_rng([seed, 1]))
     depth = np.where((depth >= depth_min) & (depth <= depth_max), depth, 0.0)
     return rgb, depth.astype(np.float32)
 
@@ -234,10 +305,44 @@ def _shade(colour: np.ndarray, normal: np.ndarray, rays: np.ndarray, hit: np.nda
     return np.where(hit[:, None], np.round(255 * np.clip(lit, 0, 1)), 0).astype(np.uint8)
 
 
-def _noisy(depth: np.ndarray, noise: DepthNoise, rng: np.random.Generator) -> np.ndarray:
+def _shadowed(scene: Scene, eye, R_world_camera, depth, baseline: float) -> np.ndarray:
+    """(H, W) bool: the pixels whose point a projector ``baseline`` m along the camera's +x cannot see."""
+    intr = scene.camera.intrinsics
+    points = pixel_rays(intr) * depth[..., None]
+    hit = depth > 0
+    world = points[hit] @ np.asarray(R_world_camera).T + eye
+    projector = np.asarray(eye, dtype=float) + baseline * np.asarray(R_world_camera)[:, 0]
+    towards = np.ascontiguousarray(world - projector)
+    n = len(towards)
+    geom, dist, normal = np.empty(n, dtype=np.int32), np.empty(n, dtype=np.float64), np.empty(3 * n)
+    mujoco.mj_multiRay(scene.model, scene.data, projector, towards.ravel(), _groups(False), 1, -1, geom, dist,
+                       normal, n, 2.0)
+    out = np.zeros(depth.shape, dtype=bool)
+    out[hit] = (geom >= 0) & (dist < 1.0 - SHADOW_SLACK / np.linalg.norm(towards, axis=1))
+    return out
+
+
+def _sensed(depth, rgb, shadow, sensor: Sensor, rng: np.random.Generator) -> np.ndarray:
+    """The exact ``depth`` as ``sensor`` reads it (:class:`Sensor`): 0 where it reads nothing.
+
+    The noise and the edge dropouts are drawn first and in that order, so that ``basic`` reads as the
+    bench's camera did before the presets, seed for seed."""
     from scipy.ndimage import maximum_filter, minimum_filter
 
-    noisy = depth + rng.normal(0.0, 1.0, depth.shape) * noise.sigma * depth**2
-    edge = maximum_filter(depth, size=3) - minimum_filter(depth, size=3) > noise.edge_jump
-    dropped = edge & (rng.random(depth.shape) < noise.edge_dropout)
-    return np.where(dropped | (depth == 0), 0.0, noisy)
+    edge = maximum_filter(depth, size=3) - minimum_filter(depth, size=3) > sensor.edge_jump
+    out = depth + rng.normal(0.0, 1.0, depth.shape) * sensor.sigma * depth**2
+    dropped = (edge & (rng.random(depth.shape) < sensor.edge_dropout)) | (depth == 0)
+    if sensor.flying:
+        near = minimum_filter(np.where(depth > 0, depth, np.inf), size=3)
+        far = maximum_filter(depth, size=3)
+        flying = edge & np.isfinite(near) & (rng.random(depth.shape) < sensor.flying)
+        mix = rng.random(depth.shape)
+        out[flying] = near[flying] + mix[flying] * (far - near)[flying]
+    if shadow is not None:
+        dropped |= shadow
+    if sensor.dark_dropout:
+        dropped |= (rgb.mean(axis=2) < DARK) & (rng.random(depth.shape) < sensor.dark_dropout)
+    if sensor.speckle:
+        seeds = rng.random(depth.shape) < sensor.speckle / SPECKLE_PX**2
+        dropped |= maximum_filter(seeds, size=SPECKLE_PX)
+    return np.where(dropped, 0.0, out)

@@ -70,7 +70,7 @@ from ..errors import InputError, NoFeasibleGrasp, SimulationError
 from ..hand import Hand
 from .clutter import build_clutter, target_pixel
 from .tendon_hand import HandDesign
-from .render import render
+from .render import DEFAULT_SENSOR, Sensor, render, tilted_view
 from .scene import Camera, Scene, Workspace, build_scene
 
 NO_PLAN = "no feasible plan"
@@ -191,8 +191,8 @@ class TrialRecord:
     wall_time: float = field(compare=False)
 
 
-def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finger-linear", noise=True,
-              timing: str = "thesis", design: HandDesign = HandDesign(), camera: Camera = Camera(),
+def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finger-linear",
+              sensor: Sensor | str = DEFAULT_SENSOR, tilt: float | None = None, timing: str = "thesis", design: HandDesign = HandDesign(), camera: Camera = Camera(),
               workspace: Workspace = Workspace(), execution: Execution = Execution(), observe=None,
               scene_kind: str = "single", pool=()) -> TrialRecord:
     """Place the object (seeded), take an RGB-D picture, plan, execute, and record the outcome.
@@ -217,8 +217,14 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
         (:meth:`~contourgrasp.sim.scene.Scene.to_reference`).
     hand : Hand or str
         The hand preset the simulated hand is built from.
-    noise : DepthNoise or bool
-        Sensor noise of the picture (see :func:`~contourgrasp.sim.render.render`).
+    sensor : Sensor or str
+        The depth sensor of the picture: a :class:`~contourgrasp.sim.render.Sensor` or a preset's name
+        (:func:`~contourgrasp.sim.render.render`).
+    tilt : float, optional
+        The picture is taken from a camera tilted this far (rad) from looking straight down, at the reference
+        camera's distance from the table's centre (:func:`~contourgrasp.sim.render.tilted_view`); the pose
+        planned in its frame is executed from the reference camera's. None: a ``single`` scene's top-down
+        camera, a ``clutter`` or ``bin`` scene's seeded tilt.
     timing, design
         Finger closing schedule and hand parameters (:mod:`contourgrasp.sim.tendon_hand`).
     camera, workspace, execution
@@ -234,7 +240,9 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
     started = time.perf_counter()
     scene = trial_scene(object_spec, seed=seed, scene_kind=scene_kind, pool=pool, hand=hand, design=design,
                         timing=timing, camera=camera, workspace=workspace)
-    rgb, depth = render(scene, noise=noise, seed=seed)
+    if tilt is not None:
+        scene.view = tilted_view(tilt, camera.height)
+    rgb, depth = render(scene, sensor=sensor, seed=seed)
     target = {} if scene.view is None else {"target_px": target_pixel(scene)}
     planning = time.perf_counter()
     try:

@@ -78,7 +78,8 @@ def test_ctrl_c_ends_a_bench_in_one_line_keeping_its_journal(tmp_path, capsys, w
     (["--objects", "can"], "other objects: case there, not here"),
     (["--planners", "paper,random"], "other planners: centroid-principal-axis there, not here; random here, not there"),
     (["--seed", "1"], "other seed: 0 there, 1 here"),
-    (["--no-noise"], "other noise: True there, False here"),
+    (["--sensor", "ideal"], "other sensor: 'structured-light' there, 'ideal' here"),
+    (["--tilt", "30"], "other tilt"),
     (["--hand", "three-finger"], "other hand"),
 ])
 def test_resume_refuses_another_configuration_and_writes_nothing(serial_bench, change, setting, capsys):

@@ -1,6 +1,7 @@
 """contourgrasp.sim.bench.report: the bench's outputs end to end (table, trial records, figures), and determinism."""
 
 import json
+import math
 
 import contourgrasp
 from contourgrasp.cli import main
@@ -13,7 +14,7 @@ import pytest
 REQUIRED = {"object", "planner", "trial", "seed", "success", "cause", "fingers_in_contact", "plan_time", "sim_time",
             "wall_time", "pose"}
 OUTPUTS = ("table.md", "trials.json", "success.png", "trials.png")
-TWO_PLANNERS = ["bench", "--objects", "can", "--trials", "2", "--planners", "paper,random", "--workers", "1"]
+TWO_PLANNERS = ["bench", "--objects", "can", "--trials", "2", "--planners", "paper,random", "--workers", "1", "--sensor", "basic"]
 
 
 def run_cli(argv, capsys) -> tuple[int, str]:
@@ -142,4 +143,7 @@ def test_the_reports_first_paragraph_says_how_the_hand_is_simulated():
 
     bench = Bench(objects=thesis_objects(["can"]), planners=("paper",), trials=1)
     text = _trials_text(bench, 1, 1.0, 0)
-    assert "Hand `five-finger-linear` (one tendon, the thesis's finger timing); depth noise on" in text
+    assert "Hand `five-finger-linear` (one tendon, the thesis's finger timing); depth sensor `structured-light`;" in text
+    tilted = _trials_text(Bench(objects=thesis_objects(["can"]), planners=("paper",), trials=1, sensor="stereo",
+                                tilt=math.radians(40)), 1, 1.0, 0)
+    assert "depth sensor `stereo`, the camera tilted 40 deg;" in tilted

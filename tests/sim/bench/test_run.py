@@ -13,7 +13,7 @@ def test_object_too_large_is_no_feasible_plan(tmp_path):
     platter = ObjectSpec("platter", (Part("cylinder", (0.40, 0.01), pos=(0.0, 0.0, 0.01)),), mass=3.0,
                          friction_hand=0.6, friction_table=0.4)
     bench = Bench(objects=(platter,), planners=("paper", "centroid-principal-axis"), trials=1,
-                  camera=Camera(height=1.0), workspace=Workspace(0.0, 0.0))
+                  camera=Camera(height=1.0), workspace=Workspace(0.0, 0.0), sensor="basic")  # 2 cm tall at 1 m
     results = run_bench(bench)
     paper, centroid = (r.record for r in results)
     assert paper.cause == NO_PLAN and "larger than the hand" in paper.plan_error

@@ -5,14 +5,15 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ...errors import SimulationError
-from ...tolerances import MAX_BENCH_TRIALS, MAX_SEED, MAX_TRIALS
+from ...tolerances import MAX_BENCH_TILT, MAX_BENCH_TRIALS, MAX_SEED, MAX_TRIALS
 from ...hand import Hand
 from ...io.hand_file import load_hand
-from ...validation import choice, integer
+from ...validation import bounded, choice, integer
 from ..clutter import SCENE_KINDS
 from ..tendon_hand import build_hand
 from ..objects import THESIS_OBJECTS, ObjectSpec, object_spec
 from ..planners import BASELINES, make_planner, synthesis_planner
+from ..render import DEFAULT_SENSOR, SENSORS
 from ..scene import Camera, Workspace
 from ..trial import DROPPED, FAILURE_CAUSES, HIT, MISSED, NO_PLAN, PUSHED, SLIPPED, STRUCK, TrialRecord, run_trial
 from ..ycb import OBJECT_SETS, load_object, object_names
@@ -42,8 +43,12 @@ class Bench:
         Trial ``t`` uses seed ``seed + t``.
     hand : Hand
         Simulated, and planned for.
-    noise : bool
-        Depth noise in the planner's picture.
+    sensor : str
+        The depth sensor of the planner's picture: a preset of :data:`~contourgrasp.sim.render.SENSORS`
+        (default :data:`~contourgrasp.sim.render.DEFAULT_SENSOR`, a structured-light camera; ``ideal``: exact).
+    tilt : float or None
+        The camera's tilt from looking straight down, rad, for every trial (at most ``MAX_BENCH_TILT``);
+        None: top-down for ``single`` scenes, the seed's 0-25 deg for ``clutter`` and ``bin``.
     camera, workspace
         Scene parameters (:mod:`contourgrasp.sim.scene`).
     splits : tuple of (str, tuple of str)
@@ -71,7 +76,8 @@ class Bench:
     trials: int = 20
     seed: int = 0
     hand: Hand = field(default_factory=lambda: load_hand("five-finger-linear"))
-    noise: bool = True
+    sensor: str = DEFAULT_SENSOR
+    tilt: float | None = None
     camera: Camera = field(default_factory=Camera)
     workspace: Workspace = field(default_factory=Workspace)
     splits: tuple[tuple[str, tuple[str, ...]], ...] = ()
@@ -80,6 +86,9 @@ class Bench:
 
     def __post_init__(self):
         choice("scene", self.scene_kind, SCENE_KINDS, error=SimulationError)
+        choice("sensor", self.sensor, tuple(SENSORS), error=SimulationError)
+        if self.tilt is not None:
+            object.__setattr__(self, "tilt", bounded("tilt", self.tilt, MAX_BENCH_TILT, " rad", error=SimulationError))
         object.__setattr__(self, "objects", tuple(self.objects))
         object.__setattr__(self, "planners", tuple(self.planners))
         object.__setattr__(self, "splits", tuple((str(s), tuple(members)) for s, members in self.splits))
@@ -141,8 +150,8 @@ class Bench:
         pool = self.pool(obj.name) if self.scene_kind != "single" else ()
         return run_trial(obj, seed=seed, planner=plan or make_planner(planner, self.hand, seed=seed),
                          hand=self.hand if self.hand_model is None else self.hand_model,
-                         noise=self.noise, camera=self.camera, workspace=self.workspace, observe=observe,
-                         scene_kind=self.scene_kind, pool=pool)
+                         sensor=self.sensor, tilt=self.tilt, camera=self.camera, workspace=self.workspace,
+                         observe=observe, scene_kind=self.scene_kind, pool=pool)
 
 
 @dataclass(frozen=True)

@@ -77,7 +77,8 @@ def settings(bench: Bench) -> dict:
         "trials": bench.trials,
         "seed": bench.seed,
         "hand": f"{bench.hand.name} {digest(bench.hand)}",
-        "noise": bench.noise,
+        "sensor": bench.sensor,
+        **({} if bench.tilt is None else {"tilt": bench.tilt}),
         "camera": digest(bench.camera),
         "workspace": digest(bench.workspace),
         **({} if bench.hand_model is None else

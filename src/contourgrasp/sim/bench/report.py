@@ -168,8 +168,12 @@ def _trials_text(bench: Bench, n_trials: int, wall_time: float, kept: int) -> st
     resumed = f" ({kept} of them run earlier and kept by --resume)" if kept else ""
     return (f"{len(bench.objects)} object(s) x {bench.trials} trial(s) x {len(bench.planners)} planner(s) = "
             f"{n_trials} trials in {wall_time:.0f} s wall time{resumed}. Hand `{bench.hand.name}` ({_simulated(bench)}"
-            f"); depth noise {'on' if bench.noise else 'off'}; trial t uses seed {bench.seed} "
+            f"); depth sensor `{bench.sensor}`{_tilt_text(bench)}; trial t uses seed {bench.seed} "
             f"+ t, the same scene for every planner.{_scene_text(bench)}")
+
+
+def _tilt_text(bench: Bench) -> str:
+    return "" if bench.tilt is None else f", the camera tilted {math.degrees(bench.tilt):.0f} deg"
 
 
 def _scene_text(bench: Bench) -> str:
@@ -179,7 +183,8 @@ def _scene_text(bench: Bench) -> str:
     what = ("2-4 objects on the table" if bench.scene_kind == "clutter" else
             "1-3 objects in a bin (walls 10 cm, floor 40 x 30 cm)")
     return (f" Scene `{bench.scene_kind}`: {what}, each object in turn the target among neighbours drawn from the "
-            "other objects of its split, touching or up to 4 cm apart; the camera tilted 0-25 deg; the planner is "
+            "other objects of its split, touching or up to 4 cm apart; the camera tilted "
+            f"{'0-25 deg' if bench.tilt is None else f'{math.degrees(bench.tilt):.0f} deg'}; the planner is "
             "given the pixel deepest inside the target's exact mask, as a user's click.")
 
 
