@@ -413,3 +413,12 @@ def test_a_command_whose_extra_is_missing_names_it_in_one_line(tmp_path, argv, e
     assert done.stderr.strip().splitlines()[-1] == (f"contourgrasp: error: {argv[0]} needs mujoco, which is not "
                                                     f"installed: pip install 'contourgrasp[{extra}]'")
     assert (tmp_path / "plan.json").is_file() and not (tmp_path / "hand.toml").exists()
+
+
+def test_bench_help_names_every_sensor_preset_and_its_default(capsys):
+    from contourgrasp.sim import DEFAULT_SENSOR, SENSORS
+
+    assert main(["bench", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    sensor = text[text.rindex("--sensor SENSOR"):text.rindex("--tilt DEG")]  # the option, not the usage line
+    assert all(name in sensor for name in SENSORS) and f"(default: {DEFAULT_SENSOR})" in sensor

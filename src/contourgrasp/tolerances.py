@@ -150,6 +150,8 @@ MIN_AREA_PX = 200
 #: region there. A steep face seen at the bench's 25 deg tilt changes by about
 #: 3 mm a pixel; an object's top against a bin wall's, by centimetres.
 CANDIDATE_DEPTH_STEP = 0.02
+#: A click on the support inside a container means the candidate within this many pixels of it, if one is inside.
+CLICK_REACH_PX = 20
 #: ... but only where one piece has another at least this fraction inside its filled outline (a bin's walls around an
 #: object touching them): an object's own steps, a block on a clamp's body, leave its pieces side by side.
 ENCLOSED_FRACTION = 0.5

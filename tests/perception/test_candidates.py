@@ -146,6 +146,25 @@ def test_target_by_pixel():
         choose_target(found, target_px=(1, 2), roi=(0, 0, 5, 5))
 
 
+def test_a_click_into_a_cup_in_a_bin_whose_rim_read_nothing_in_places_means_the_cup():
+    # Bin walls round the scene's middle; inside, a cup: a ring 8 cm tall whose rim has a 10 px gap (dropouts), so
+    # its filled mask does not hold its inside. A click on the cup's bottom (on the support) means the cup, not the
+    # bin whose filled ring holds the pixel; a click in an empty corner of the bin still means the bin.
+    depth = scene((150, 100, 340, 10, 0.10), (150, 370, 340, 10, 0.10), (150, 100, 10, 280, 0.10),
+                  (480, 100, 10, 280, 0.10))
+    v, u = np.indices(depth.shape)
+    r = np.hypot(u - 300, v - 240)
+    depth[(r > 12) & (r < 22) & ~((u > 295) & (u < 305) & (v < 240))] = TABLE - 0.08
+    found = candidates(depth)
+    plane = fit_table_plane(depth, CAMERA)
+    ph = heights(depth, CAMERA, plane)
+    cup, reason = choose_target(found, target_px=(300, 240), pixel_heights=ph)
+    assert cup.area_px < 3000 and "inside the container clicked in" in reason
+    assert not cup.mask[240, 300]  # the cup's filled mask misses its inside: the rim is open
+    corner, _ = choose_target(found, target_px=(200, 150), pixel_heights=ph)
+    assert corner.area_px > 10000
+
+
 def test_target_by_roi():
     found = candidates(scene(A, B, C))
     # covers all of C, a strip of A and a corner of B: the wholly visible one with most area in it is A

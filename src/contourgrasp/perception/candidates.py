@@ -31,7 +31,7 @@ from scipy import ndimage
 
 from .. import validation
 from ..errors import PerceptionError, SegmentationError
-from ..tolerances import (CANDIDATE_DEPTH_STEP, CONTAINER_FLOOR_AREA, ENCLOSED_FRACTION, FLAT_HEIGHT_SIGMAS,
+from ..tolerances import (CANDIDATE_DEPTH_STEP, CLICK_REACH_PX, CONTAINER_FLOOR_AREA, ENCLOSED_FRACTION, FLAT_HEIGHT_SIGMAS,
                           LOW_PART_REACH_PX, LOW_PART_STEP, MIN_AREA_PX, MIN_HEIGHT, SENSOR_RANGE,
                           SIMILAR_SIZE)
 from ._pixels import check_pixel, connected_to, even_box, stats_in_image
@@ -359,6 +359,9 @@ def choose_target(candidates, *, target_px=None, roi=None, rule: str = "hand",
         if pixel_heights is not None and candidates:
             validation.same_size(np.shape(pixel_heights), shape, "pixel_heights", "the depth image",
                                  error=PerceptionError)
+            found = _beside_in_container(candidates, pixel, pixel_heights)
+            if found is not None:
+                return found, f"the candidate beside pixel ({pixel[0]}, {pixel[1]}), inside the container clicked in"
             found = low_part_candidate(candidates, pixel, pixel_heights)
             if found is not None:
                 return found, f"the candidate the low part under pixel ({pixel[0]}, {pixel[1]}) belongs to"
@@ -413,6 +416,30 @@ def check_roi(roi, shape=None) -> tuple[int, int, int, int]:
     if shape is not None and (x >= shape[1] or y >= shape[0] or x + w <= 0 or y + h <= 0):
         raise SegmentationError("no-object", f"the ROI ({x}, {y}, {w}, {h}) is outside the {shape[1]}x{shape[0]} image")
     return x, y, w, h
+
+
+def _beside_in_container(candidates, pixel, pixel_heights) -> Candidate | None:
+    """The candidate a click on the support inside a container (a bin's walls) meant, or None.
+
+    A click on an object's inside seen through its opening (a mug's bottom) lands on the support
+    when the object's rim is broken by missing readings: the object's filled mask does not hold the
+    pixel, the bin's does. When the clicked pixel stands less than ``MIN_HEIGHT`` above the support,
+    the innermost candidate holding it encloses others, and one of those comes within
+    ``CLICK_REACH_PX`` of the pixel, that nearest one is meant. A click in a roll of tape's eye, with
+    nothing inside the tape, stays the tape's.
+    """
+    u, v = pixel
+    if not pixel_heights[v, u] < MIN_HEIGHT:
+        return None
+    holding = sorted((c for c in candidates if c.mask[v, u]), key=lambda c: int(c.mask.sum()))
+    if not holding:
+        return None
+    container = holding[0]
+    inside = [c for c in candidates if c is not container
+              and (c.mask & container.mask).sum() > ENCLOSED_FRACTION * c.mask.sum()]
+    near = [(np.hypot(*(np.array(_nearest_pixel(c.mask, u, v)) - (u, v))), c) for c in inside]
+    near = [(d, c) for d, c in near if d <= CLICK_REACH_PX]
+    return min(near, key=lambda dc: dc[0])[1] if near else None
 
 
 def _at_pixel(candidates, pixel, shape):
