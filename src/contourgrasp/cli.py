@@ -13,6 +13,7 @@ import math
 import sys
 import time
 import warnings
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -292,6 +293,8 @@ def _add_bench_parser(sub) -> None:
     bench.add_argument("--tilt", type=_tilt_degrees, metavar="DEG",
                        help="the camera tilted DEG (0-65) from looking straight down, for every trial (default: "
                             "top-down for single scenes, 0-25 deg by seed for clutter and bin)")
+    bench.add_argument("--robot-in-view", action="store_true",
+                       help="a robot arm and its gripper beside the workspace in every picture, seen and never touched")
     bench.add_argument("--workers", type=_positive_int,
                        help="run the trials in this many processes (default: the number of cores; 1: in this one)")
     bench.add_argument("--ray", nargs="?", const="", metavar="ADDRESS",
@@ -598,7 +601,7 @@ def _bench(args) -> int:
     hand = load_hand(args.hand or "five-finger-linear") if mounted is None else mounted.hand
     setup = bench.Bench(objects=objects, planners=planners, trials=args.trials, seed=args.seed, hand=hand,
                         sensor=args.sensor, tilt=None if args.tilt is None else math.radians(args.tilt),
-                        splits=splits, hand_model=mounted,
+                        robot=args.robot_in_view, splits=splits, hand_model=mounted,
                         scene_kind=args.scene)
     journal, done = bench.resume(out, setup) if args.resume is not None else (None, ())
     with bench.executor(setup, workers=args.workers, ray=args.ray is not None, address=args.ray or None) as run:
@@ -752,9 +755,9 @@ def main(argv=None) -> int:
             code, message = EXIT_INTERRUPTED, "interrupted" + _kept(args)
         except OSError as err:
             code, message = EXIT_INPUT, f"error: {_os_error(err)}"
-    for w in caught:
-        if issubclass(w.category, ContourGraspWarning):
-            print(f"contourgrasp: warning: {w.message}", file=sys.stderr)
+    said = Counter(str(w.message) for w in caught if issubclass(w.category, ContourGraspWarning))
+    for text, times in said.items():  # a bench's trials warn alike: once each, counted
+        print(f"contourgrasp: warning: {text}{f' ({times} times)' if times > 1 else ''}", file=sys.stderr)
     if message:
         print(f"contourgrasp: {message}", file=sys.stderr)
     return code

@@ -10,7 +10,7 @@ from contourgrasp.sim import (SENSORS, Camera, build_scene, hand_pose_from_matri
                               render_view, tilted_view)
 from contourgrasp.sim.objects import flat_tool
 from contourgrasp.sim.planners import make_planner
-from contourgrasp.sim.scene import R_WORLD_CAMERA, Workspace
+from contourgrasp.sim.scene import R_WORLD_CAMERA, ROBOT_ARM, Workspace
 
 TILT = np.radians(12.7)
 
@@ -156,3 +156,25 @@ def test_a_plan_from_a_tilted_camera_lands_on_the_object(name):
     centre = T_world_hand @ [*hand.grasp_centre, 0.0, 1.0]
     assert Delaunay(scene.object_points()[:, :2]).find_simplex(centre[:2]) >= 0  # over the object's outline
     assert abs(T_world_hand[2, 3] - (scene.object_points()[:, 2].max() - 0.01)) < 0.003
+
+
+@pytest.mark.parametrize("tilt", [0.0, 30.0, 60.0])
+def test_a_robot_arm_in_view_enters_from_the_border_touches_nothing_and_is_not_planned_on(tilt):
+    # The arm of ROBOT_ARM beside the workspace: in every view it crosses the image's top border, the object's
+    # pixels are those of the scene without it, nothing touches it, and the plan is the plan without it.
+    view = tilted_view(np.radians(tilt), 0.65)
+    scene, bare = build_scene("can", seed=3, robot=True), build_scene("can", seed=3)
+    _, with_arm = render(scene, view=view)
+    _, without = render(bare, view=view)
+    arm = np.abs(with_arm - without) > 1e-6
+    assert arm.sum() > 500 and arm[0].any()
+    np.testing.assert_array_equal(object_truth(scene, view)[0], object_truth(bare, view)[0])
+    robot = [scene.model.geom(f"robot_{k}").id for k in range(len(ROBOT_ARM))]
+    assert not np.isin(scene.data.contact.geom[: scene.data.ncon], robot).any()
+    hand = contourgrasp.load_hand("five-finger-linear")
+    plans = [contourgrasp.plan_grasp(*render(s, sensor="structured-light", seed=3, view=view), s.camera.intrinsics,
+                                     hand=hand) for s in (scene, bare)]
+    masks = [p.segmentation.mask for p in plans]
+    assert (masks[0] & masks[1]).sum() > 0.99 * (masks[0] | masks[1]).sum()  # the support's fit sees the arm's edge
+    np.testing.assert_allclose(plans[0].T_camera_hand[:3, 3], plans[1].T_camera_hand[:3, 3], atol=0.002)
+    np.testing.assert_allclose(plans[0].T_camera_hand[:3, :3], plans[1].T_camera_hand[:3, :3], atol=0.03)

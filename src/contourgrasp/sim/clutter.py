@@ -203,7 +203,7 @@ def overlap(a: np.ndarray, b: np.ndarray) -> bool:
 
 def build_clutter(obj, pool, *, kind: str, seed: int, hand: Hand | str = "five-finger-linear",
                   design: HandDesign = HandDesign(), timing: str = "thesis", camera: Camera = Camera(),
-                  workspace: Workspace = Workspace(), settle: float = CLUTTER_SETTLE) -> Scene:
+                  workspace: Workspace = Workspace(), settle: float = CLUTTER_SETTLE, robot: bool = False) -> Scene:
     """A settled ``clutter`` or ``bin`` scene: ``obj`` the target, neighbours from ``pool``, a seeded tilted camera.
 
     Parameters
@@ -218,13 +218,15 @@ def build_clutter(obj, pool, *, kind: str, seed: int, hand: Hand | str = "five-f
         reference the grasp is executed in, and its height the tilted camera's distance.
     settle : float
         Seconds the objects settle before anything looks at them.
+    robot : bool
+        A robot arm in view (:data:`~contourgrasp.sim.scene.ROBOT_ARM`).
     """
     obj = object_spec(obj)
     layout = arrange(kind, obj, [object_spec(o) for o in pool], seed=seed, workspace=workspace)
     hand_model = build_hand(load_hand(hand), design=design, timing=timing)
     with mujoco_warnings():
         model = mujoco.MjModel.from_xml_string(scene_xml(obj, hand_model, layout.target,
-                                                         neighbours=layout.neighbours, bin=layout.bin))
+                                                         neighbours=layout.neighbours, bin=layout.bin, robot=robot))
         data = mujoco.MjData(model)
     scene = Scene(model, data, obj, hand_model, camera, layout.target, kind=kind,
                   neighbours=tuple(o for o, _ in layout.neighbours), bin=layout.bin,

@@ -15,7 +15,10 @@ for :data:`SETTLE_TIME` before anything looks at it.
 A scene may also hold neighbours (bodies ``neighbour_0``, ...) and a
 :class:`Bin`, whose floor's top is then the plane z = 0 and the table that much
 lower; :mod:`contourgrasp.sim.clutter` arranges and builds such scenes, and
-:attr:`Scene.view` is their tilted camera.
+:attr:`Scene.view` is their tilted camera. With ``robot=True`` a robot arm
+(:data:`ROBOT_ARM`) is parked beside the workspace, in every camera's view: it
+is seen and never touched (it has no contacts), as a robot's own arm and gripper
+are in the picture of a camera that watches its table.
 
 Contacts
 --------
@@ -167,6 +170,18 @@ class Bin:
         """(...) bool: whether world points (..., 2) lie over the floor inside the walls."""
         xy = np.asarray(xy, dtype=float)
         return (np.abs(xy[..., 0]) < self.inner[0] / 2) & (np.abs(xy[..., 1]) < self.inner[1] / 2)
+
+
+#: The robot arm in view (``robot=True``): (type, size, from-to or position, rgba) of static geoms, world frame, m.
+#: Its forearm comes down from beyond the image's top border to a parallel gripper whose dark fingers
+#: hang 9 cm above the table at (-0.20, 0.20), 12 cm beyond the workspace's corner; seen by every camera of
+#: :mod:`contourgrasp.sim.render` up to a 60 deg tilt, and leaving through the image's top border in all of them.
+ROBOT_ARM = (
+    ("capsule", "0.04", "-0.26 1.0 0.50 -0.20 0.20 0.20", (0.80, 0.80, 0.82, 1.0)),
+    ("box", "0.05 0.02 0.02", "-0.20 0.20 0.18", (0.15, 0.15, 0.15, 1.0)),
+    ("box", "0.008 0.012 0.035", "-0.235 0.20 0.125", (0.15, 0.15, 0.15, 1.0)),
+    ("box", "0.008 0.012 0.035", "-0.165 0.20 0.125", (0.15, 0.15, 0.15, 1.0)),
+)
 
 
 @dataclass(frozen=True)
@@ -332,7 +347,8 @@ def _ignore(message: str) -> None:
 
 
 def build_scene(obj, *, seed: int, hand: Hand | str = "five-finger-linear", design: HandDesign = HandDesign(),
-                timing: str = "thesis", camera: Camera = Camera(), workspace: Workspace = Workspace()) -> Scene:
+                timing: str = "thesis", camera: Camera = Camera(), workspace: Workspace = Workspace(),
+                robot: bool = False) -> Scene:
     """A settled scene: the object at a seeded random position and yaw, the hand parked out of view.
 
     Parameters
@@ -348,6 +364,8 @@ def build_scene(obj, *, seed: int, hand: Hand | str = "five-finger-linear", desi
         See :func:`~contourgrasp.sim.tendon_hand.build_hand`.
     camera : Camera
     workspace : Workspace
+    robot : bool
+        A robot arm in view (:data:`ROBOT_ARM`).
     """
     obj = object_spec(obj)
     hand_model = hand if hasattr(hand, "mount") else build_hand(load_hand(hand), design=design, timing=timing)
@@ -356,7 +374,7 @@ def build_scene(obj, *, seed: int, hand: Hand | str = "five-finger-linear", desi
                           y=float(rng.uniform(-workspace.half_y, workspace.half_y)),
                           yaw=float(rng.uniform(0.0, 2 * np.pi)))
     with mujoco_warnings():
-        model = _compile(scene_xml(obj, hand_model, placement), hand_model)
+        model = _compile(scene_xml(obj, hand_model, placement, robot=robot), hand_model)
         data = mujoco.MjData(model)
     scene = Scene(model, data, obj, hand_model, camera, placement)
     scene.set_hand(0.0, 0.0, PARK_HEIGHT, 0.0)
@@ -373,18 +391,20 @@ def _compile(xml: str, hand) -> mujoco.MjModel:
     return spec.compile()
 
 
-def scene_xml(obj: ObjectSpec, hand: HandModel, placement: Placement, *, neighbours=(), bin: Bin | None = None) -> str:
+def scene_xml(obj: ObjectSpec, hand: HandModel, placement: Placement, *, neighbours=(), bin: Bin | None = None,
+              robot: bool = False) -> str:
     """The MJCF text of the whole scene.
 
     The object is body ``object``; ``neighbours``, (ObjectSpec, Placement)
     pairs, are bodies ``neighbour_0``, ... dropped from :data:`DROP_HEIGHT`;
     a ``bin`` is fixed to the world, its floor's top at z = 0 and the table
-    that much lower.
+    that much lower; ``robot`` adds the arm of :data:`ROBOT_ARM` (geoms ``robot_0``, ...).
     """
     assets = []
     bodies = [_body_xml("object", obj, placement, assets, z=0.001)]
     bodies += [_body_xml(f"neighbour_{k}", o, p, assets, z=DROP_HEIGHT) for k, (o, p) in enumerate(neighbours)]
     statics = [] if bin is None else [_box_xml(name, size, pos, bin.rgba) for name, size, pos in bin.geoms()]
+    statics += _robot_xml() if robot else []
     table_z = -0.02 - (bin.floor if bin is not None else 0.0)
     pairs = _pairs([("object", obj), *((f"neighbour_{k}", o) for k, (o, _) in enumerate(neighbours))], hand, bin)
     return f"""<mujoco model="contourgrasp-sim">
@@ -433,6 +453,14 @@ def _box_xml(name: str, size, pos, rgba) -> str:
     return (f'<geom name="{name}" type="box" size="{" ".join(f"{v:.9g}" for v in size)}" '
             f'pos="{" ".join(f"{v:.9g}" for v in pos)}" rgba="{" ".join(f"{v:.4g}" for v in rgba)}" '
             f'contype="{TABLE_BIT}" conaffinity="{HAND_BIT}" group="0"/>')
+
+
+def _robot_xml() -> list[str]:
+    """The geoms of :data:`ROBOT_ARM`: seen by the camera (group 0), in contact with nothing."""
+    place = {"capsule": "fromto", "box": "pos"}
+    return [f'<geom name="robot_{k}" type="{kind}" size="{size}" {place[kind]}="{where}" '
+            f'rgba="{" ".join(f"{v:g}" for v in rgba)}" contype="0" conaffinity="0" group="0"/>'
+            for k, (kind, size, where, rgba) in enumerate(ROBOT_ARM)]
 
 
 def _pairs(bodies, hand: HandModel, bin: Bin | None = None) -> list[str]:

@@ -194,7 +194,7 @@ class TrialRecord:
 def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finger-linear",
               sensor: Sensor | str = DEFAULT_SENSOR, tilt: float | None = None, timing: str = "thesis", design: HandDesign = HandDesign(), camera: Camera = Camera(),
               workspace: Workspace = Workspace(), execution: Execution = Execution(), observe=None,
-              scene_kind: str = "single", pool=()) -> TrialRecord:
+              scene_kind: str = "single", pool=(), robot: bool = False) -> TrialRecord:
     """Place the object (seeded), take an RGB-D picture, plan, execute, and record the outcome.
 
     Parameters
@@ -236,10 +236,12 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
         The scene (:mod:`contourgrasp.sim.clutter`); ``object_spec`` is its target.
     pool : sequence of ObjectSpec
         The neighbours of a ``clutter`` or ``bin`` scene are drawn from it.
+    robot : bool
+        A robot arm in the picture (:data:`~contourgrasp.sim.scene.ROBOT_ARM`), seen and never touched.
     """
     started = time.perf_counter()
     scene = trial_scene(object_spec, seed=seed, scene_kind=scene_kind, pool=pool, hand=hand, design=design,
-                        timing=timing, camera=camera, workspace=workspace)
+                        timing=timing, camera=camera, workspace=workspace, robot=robot)
     if tilt is not None:
         scene.view = tilted_view(tilt, camera.height)
     rgb, depth = render(scene, sensor=sensor, seed=seed)

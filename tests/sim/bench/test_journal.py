@@ -80,6 +80,7 @@ def test_ctrl_c_ends_a_bench_in_one_line_keeping_its_journal(tmp_path, capsys, w
     (["--seed", "1"], "other seed: 0 there, 1 here"),
     (["--sensor", "ideal"], "other sensor: 'structured-light' there, 'ideal' here"),
     (["--tilt", "30"], "other tilt"),
+    (["--robot-in-view"], "other robot in view"),
     (["--hand", "three-finger"], "other hand"),
 ])
 def test_resume_refuses_another_configuration_and_writes_nothing(serial_bench, change, setting, capsys):

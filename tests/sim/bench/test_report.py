@@ -5,6 +5,7 @@ import math
 
 import contourgrasp
 from contourgrasp.cli import main
+from contourgrasp.errors import SimulationError
 from contourgrasp.sim.bench import BenchTrial, Bench, ablation_table, picked_failures, thesis_objects, write_outputs
 from contourgrasp.sim.planners import ablation_planners
 from contourgrasp.sim.trial import PUSHED, TrialRecord
@@ -147,3 +148,7 @@ def test_the_reports_first_paragraph_says_how_the_hand_is_simulated():
     tilted = _trials_text(Bench(objects=thesis_objects(["can"]), planners=("paper",), trials=1, sensor="stereo",
                                 tilt=math.radians(40)), 1, 1.0, 0)
     assert "depth sensor `stereo`, the camera tilted 40 deg;" in tilted
+    robot = _trials_text(Bench(objects=thesis_objects(["can"]), planners=("paper",), trials=1, robot=True), 1, 1.0, 0)
+    assert "depth sensor `structured-light`, a robot arm in view (seen, never touched);" in robot
+    with pytest.raises(SimulationError, match="robot must be True or False"):
+        Bench(objects=thesis_objects(["can"]), robot="yes")

@@ -49,6 +49,8 @@ class Bench:
     tilt : float or None
         The camera's tilt from looking straight down, rad, for every trial (at most ``MAX_BENCH_TILT``);
         None: top-down for ``single`` scenes, the seed's 0-25 deg for ``clutter`` and ``bin``.
+    robot : bool
+        A robot arm in every picture (:data:`~contourgrasp.sim.scene.ROBOT_ARM`), seen and never touched.
     camera, workspace
         Scene parameters (:mod:`contourgrasp.sim.scene`).
     splits : tuple of (str, tuple of str)
@@ -78,6 +80,7 @@ class Bench:
     hand: Hand = field(default_factory=lambda: load_hand("five-finger-linear"))
     sensor: str = DEFAULT_SENSOR
     tilt: float | None = None
+    robot: bool = False
     camera: Camera = field(default_factory=Camera)
     workspace: Workspace = field(default_factory=Workspace)
     splits: tuple[tuple[str, tuple[str, ...]], ...] = ()
@@ -87,6 +90,8 @@ class Bench:
     def __post_init__(self):
         choice("scene", self.scene_kind, SCENE_KINDS, error=SimulationError)
         choice("sensor", self.sensor, tuple(SENSORS), error=SimulationError)
+        if not isinstance(self.robot, bool):
+            raise SimulationError(f"robot must be True or False, got {self.robot!r}")
         if self.tilt is not None:
             object.__setattr__(self, "tilt", bounded("tilt", self.tilt, MAX_BENCH_TILT, " rad", error=SimulationError))
         object.__setattr__(self, "objects", tuple(self.objects))
@@ -151,7 +156,7 @@ class Bench:
         return run_trial(obj, seed=seed, planner=plan or make_planner(planner, self.hand, seed=seed),
                          hand=self.hand if self.hand_model is None else self.hand_model,
                          sensor=self.sensor, tilt=self.tilt, camera=self.camera, workspace=self.workspace,
-                         observe=observe, scene_kind=self.scene_kind, pool=pool)
+                         observe=observe, scene_kind=self.scene_kind, pool=pool, robot=self.robot)
 
 
 @dataclass(frozen=True)

@@ -79,6 +79,7 @@ def settings(bench: Bench) -> dict:
         "hand": f"{bench.hand.name} {digest(bench.hand)}",
         "sensor": bench.sensor,
         **({} if bench.tilt is None else {"tilt": bench.tilt}),
+        **({"robot in view": True} if bench.robot else {}),
         "camera": digest(bench.camera),
         "workspace": digest(bench.workspace),
         **({} if bench.hand_model is None else

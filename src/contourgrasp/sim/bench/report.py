@@ -173,7 +173,8 @@ def _trials_text(bench: Bench, n_trials: int, wall_time: float, kept: int) -> st
 
 
 def _tilt_text(bench: Bench) -> str:
-    return "" if bench.tilt is None else f", the camera tilted {math.degrees(bench.tilt):.0f} deg"
+    tilt = "" if bench.tilt is None else f", the camera tilted {math.degrees(bench.tilt):.0f} deg"
+    return tilt + (", a robot arm in view (seen, never touched)" if bench.robot else "")
 
 
 def _scene_text(bench: Bench) -> str:
