@@ -259,6 +259,11 @@ HEIGHT_MAP_MARGIN = 0.20
 #: short of the object's edge (the footprint of a tilted camera misses 1-3 px on the object's far side).
 HEIGHT_MAP_OBJECT_BAND = 0.006
 
+#: Height map: a cell stands up (an obstacle) only within this many cells of one where a reading's 3 x 3
+#: median stands ``MIN_HEIGHT`` up too: a lone noisy reading on the table is no wall, an object's edge
+#: keeps its highest readings.
+STEADY_REACH_CELLS = 2
+
 #: Height map: the largest cell (m) and margin (m) accepted; beyond them a value is a unit slip.
 MAX_HEIGHT_MAP_CELL = 0.1
 MAX_HEIGHT_MAP_MARGIN = 2.0

@@ -74,10 +74,10 @@ import numpy as np
 from .. import validation
 from ..errors import PerceptionError
 from ..tolerances import (HEIGHT_MAP_CELL, HEIGHT_MAP_MARGIN, HEIGHT_MAP_OBJECT_BAND, MAX_HEIGHT_MAP_CELL, MAX_HEIGHT_MAP_CELLS,
-                          MAX_HEIGHT_MAP_MARGIN, MIN_HEIGHT, SENSOR_RANGE)
+                          MAX_HEIGHT_MAP_MARGIN, MIN_HEIGHT, SENSOR_RANGE, STEADY_REACH_CELLS)
 from ._pixels import dilate
 from ._ray_kernels import ray_bounds, shadow_bounds
-from .camera import Intrinsics, as_depth, check_intrinsics, denoised_at, pixel_points_at, valid_depth
+from .camera import Intrinsics, as_depth, check_intrinsics, denoised_at, denoised_depth, pixel_points_at, valid_depth
 from .metric import MetricContour
 from .table import Plane, heights as plane_heights
 
@@ -380,12 +380,14 @@ def height_map(
     np.maximum.at(grid, flat, h)
     obj = np.zeros(nx * ny, dtype=bool)
     obj[flat[m[on_grid] & (h >= MIN_HEIGHT)]] = True
+    steady = np.zeros(nx * ny, dtype=bool)
+    steady[flat[plane_heights(denoised_depth(d, valid), intrinsics, plane)[on_grid] >= MIN_HEIGHT]] = True
     grid[np.isneginf(grid)] = np.nan
     grid = _fill_gaps(grid.reshape(ny, nx))
     obj = obj.reshape(ny, nx) | _inside(metric.contour_xy, lo_xy, cell, (ny, nx))
     seen = np.isfinite(grid)
-    with np.errstate(invalid="ignore"):
-        raised = seen & (grid >= MIN_HEIGHT)
+    with np.errstate(invalid="ignore"):  # a spike of noise is no obstacle (module docstring)
+        raised = seen & (grid >= MIN_HEIGHT) & dilate(steady.reshape(ny, nx), STEADY_REACH_CELLS)
     obj |= raised & dilate(obj, int(math.ceil(HEIGHT_MAP_OBJECT_BAND / cell - 1e-9)))
     grid = np.where(seen & ~raised & ~obj, np.minimum(grid, 0.0), grid)  # the table at its plane (module docstring)
 
