@@ -367,12 +367,15 @@ def check_candidates(hand: Hand, descent: Descent, poses, order, lam=None,
         tip[rows] = raised
         passed[rows] = raised <= descent.max_tip_height
         cleared = last if passed[rows].any() else cleared
-        if descent.sweep and lam is not None:
-            passed[rows] &= ~_swept(link_first, hand, descent.heights, poses[rows], raised, lam[rows], touching[rows])
+        if descent.sweep and lam is not None:  # the sweeps of the poses still passing only: the costly part
+            keep = passed[rows]
+            passed[rows[keep]] = ~_swept(link_first, hand, descent.heights, poses[rows[keep]], raised[keep],
+                                         lam[rows[keep]], touching[rows[keep]])
         if descent.closing_map is not None and lam is not None:
             obstacles, centres = descent.closing_map
-            passed[rows] &= ~_swept(partial(closing_hits, centres=centres), hand, obstacles, poses[rows], raised,
-                                    lam[rows], touching[rows])
+            keep = passed[rows]
+            passed[rows[keep]] = ~_swept(partial(closing_hits, centres=centres), hand, obstacles, poses[rows[keep]],
+                                         raised[keep], lam[rows[keep]], touching[rows[keep]])
         if passed[rows].any():
             break
     return passed, tip, cleared or last
