@@ -73,7 +73,13 @@ def test_the_walks_toward_the_camera_stopped_early_give_the_bounds_of_every_step
     diagonal = math.sqrt(2.0) * cell
     reach = np.minimum(r, top * r / camera_height + 2 * diagonal)
     steps = np.arange(1, int(math.ceil(2 * reach.max() / cell)) + 1) * (0.5 * cell)
-    got = shadow_bounds(heights, start, unit, r, reach, steps, origin, cell, camera_height, diagonal, top)
+    got = shadow_bounds(heights, start, unit, r, reach, steps, origin, cell, camera_height, diagonal, top,
+                        np.full(len(start), np.inf))
     want = walk_every_step_toward(heights, start, unit, r, reach, steps, origin, cell, camera_height, diagonal)
     np.testing.assert_array_equal(got, want)
     assert np.isfinite(got).mean() > 0.5 and (got > 0.1).any()  # the walks do cross seen cells, the block among them
+    # Capped (by the bound away from the camera, which the cell takes when smaller): the smaller of the two is exact.
+    cap = rng.uniform(0.0, 0.2, len(start))
+    capped = shadow_bounds(heights, start, unit, r, reach, steps, origin, cell, camera_height, diagonal, top, cap)
+    np.testing.assert_array_equal(np.minimum(capped, cap), np.minimum(want, cap))
+    assert (capped < want).any()  # some walks did stop at their cap

@@ -10,7 +10,8 @@ give less than the bound found, no later step can raise it. Away from it the bou
 ``h + (H - h) gap / far``, which grows with ``h`` and as the walk goes on: once even the map's lowest
 seen height would give more than the bound found, no later step can lower it. A step's arithmetic is
 the bound's definition, term for term, so stopping early changes no bound (tested against every
-step walked).
+step walked). The cell takes the smaller of the two, so a walk toward the camera also stops once its
+bound reaches the one away from it (``cap``): it can only grow, and the smaller is then known.
 """
 
 from __future__ import annotations
@@ -69,8 +70,9 @@ def ray_bounds(heights, start, unit, r, steps, origin, cell, camera_height, diag
 
 
 @njit(cache=True)
-def shadow_bounds(heights, start, unit, r, reach, steps, origin, cell, camera_height, diagonal, top):
-    """(n,) float: per unseen cell the highest line of sight over the seen cells toward the camera (-inf: none).
+def shadow_bounds(heights, start, unit, r, reach, steps, origin, cell, camera_height, diagonal, top, cap):
+    """(n,) float: per unseen cell the highest line of sight over the seen cells toward the camera (-inf: none),
+    or a height at least ``cap`` when the walk reaches it.
 
     Parameters
     ----------
@@ -85,6 +87,8 @@ def shadow_bounds(heights, start, unit, r, reach, steps, origin, cell, camera_he
     origin : (2,) float
     cell, camera_height, diagonal, top : float
         Cell size, the camera's height above the table, a cell's diagonal, the highest seen height.
+    cap : (n,) float
+        The walk stops once its bound reaches this (+inf: never); the bound then returned is at least it.
     """
     ny, nx = heights.shape
     out = np.empty(start.shape[0])
@@ -100,11 +104,14 @@ def shadow_bounds(heights, start, unit, r, reach, steps, origin, cell, camera_he
                 break  # no later step can raise the bound
             col = math.floor((start[i, 0] + s * unit[i, 0] - origin[0]) / cell)
             row = math.floor((start[i, 1] + s * unit[i, 1] - origin[1]) / cell)
-            if 0 <= col < nx and 0 <= row < ny:
-                h = heights[int(row), int(col)]
-                b = h - (camera_height - h) * gap / depth
-                if math.isfinite(b) and b > best:
-                    best = b
+            if not (0 <= col < nx and 0 <= row < ny):
+                break  # off the map, which a straight walk from inside it does not enter again
+            h = heights[int(row), int(col)]
+            b = h - (camera_height - h) * gap / depth
+            if math.isfinite(b) and b > best:
+                best = b
+                if best >= cap[i]:
+                    break  # the cell takes the smaller bound: the cap
             if s >= reach[i]:
                 break  # the rest of the walk repeats this step
         out[i] = best

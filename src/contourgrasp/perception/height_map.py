@@ -264,11 +264,12 @@ class HeightMap:
         reach = np.minimum(r, max(top, 0.0) * r / height + 2 * diagonal)
         span = min(float(np.hypot(*self.shape)) * self.cell, float(reach.max()))
         steps = np.arange(1, int(math.ceil(2 * span / self.cell)) + 1) * (0.5 * self.cell)  # half cells: no cell skipped
-        shadow = shadow_bounds(self.heights, start, unit, r, reach, steps, origin, cell, height, diagonal, top)
-        shadow = np.where(shadow > -MIN_HEIGHT, np.maximum(shadow, 0.0), top)
         across = np.arange(1, int(math.ceil(2 * np.hypot(*self.shape))) + 1) * (0.5 * self.cell)
-        rays = ray_bounds(self.heights, start, -unit, r, across, origin, cell, height, diagonal, float(out[seen].min()))
-        out[rows, cols] = np.minimum(shadow, np.maximum(rays, 0.0))
+        rays = np.maximum(ray_bounds(self.heights, start, -unit, r, across, origin, cell, height, diagonal,
+                                     float(out[seen].min())), 0.0)
+        shadow = shadow_bounds(self.heights, start, unit, r, reach, steps, origin, cell, height, diagonal, top, rays)
+        shadow = np.where(shadow > -MIN_HEIGHT, np.maximum(shadow, 0.0), top)
+        out[rows, cols] = np.minimum(shadow, rays)
         return out
 
 
