@@ -1,7 +1,7 @@
 """Planning time per frame (the target: under 100 ms): `plan_frame` on simulated frames, per planner.
 
-One simulated RGB-D frame per thesis object (seed 3 unless ``--seed``, depth noise on), planned with
-the `five-finger-linear` hand: perception, synthesis and the 6-DoF pose, exactly
+One simulated RGB-D frame per thesis object (seed 3 unless ``--seed``, the ``basic`` sensor: noise and
+edge dropouts), planned with the `five-finger-linear` hand: perception, synthesis and the 6-DoF pose, exactly
 what a bench trial's planner does. Prints, per planner and object, the median
 wall time of 5 runs (``--runs``) after a warm-up, the slowest of them, and the
 synthesis's share (its ``timing_ms.total``), then a line per planner: the slowest median and plan, the
