@@ -13,7 +13,6 @@ import math
 import sys
 import time
 import warnings
-from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -755,9 +754,9 @@ def main(argv=None) -> int:
             code, message = EXIT_INTERRUPTED, "interrupted" + _kept(args)
         except OSError as err:
             code, message = EXIT_INPUT, f"error: {_os_error(err)}"
-    said = Counter(str(w.message) for w in caught if issubclass(w.category, ContourGraspWarning))
-    for text, times in said.items():  # a bench's trials warn alike: once each, counted
-        print(f"contourgrasp: warning: {text}{f' ({times} times)' if times > 1 else ''}", file=sys.stderr)
+    for w in caught:
+        if issubclass(w.category, ContourGraspWarning):
+            print(f"contourgrasp: warning: {w.message}", file=sys.stderr)
     if message:
         print(f"contourgrasp: {message}", file=sys.stderr)
     return code

@@ -62,11 +62,12 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from ..errors import InputError, NoFeasibleGrasp, SimulationError
+from ..errors import ContourGraspWarning, InputError, NoFeasibleGrasp, SimulationError
 from ..hand import Hand
 from .clutter import build_clutter, target_pixel
 from .tendon_hand import HandDesign
@@ -248,7 +249,9 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
     target = {} if scene.view is None else {"target_px": target_pixel(scene)}
     planning = time.perf_counter()
     try:
-        transform, approach_depth, *planned_height = planner(rgb, depth, camera.intrinsics, **target)
+        with warnings.catch_warnings():  # a trial's record is its outcome: its perception's notes are not printed
+            warnings.simplefilter("ignore", ContourGraspWarning)
+            transform, approach_depth, *planned_height = planner(rgb, depth, camera.intrinsics, **target)
         if scene.view is not None:
             *pose, approach_depth = scene.to_reference(transform)
             transform = pose_matrix(*pose, approach_depth)
