@@ -264,6 +264,11 @@ HEIGHT_MAP_OBJECT_BAND = 0.006
 #: keeps its highest readings.
 STEADY_REACH_CELLS = 2
 
+#: Height map: an unseen cell that no seen surface can have hidden (a dropout beside an edge, speckle) and that lies
+#: within this distance (m) of seen cells is bounded by the highest of them; farther inside a hole, by the map's
+#: highest seen height. Edge dropouts and speckle leave holes a few millimetres wide.
+HOLE_BORDER_REACH = 0.006
+
 #: Height map: the largest cell (m) and margin (m) accepted; beyond them a value is a unit slip.
 MAX_HEIGHT_MAP_CELL = 0.1
 MAX_HEIGHT_MAP_MARGIN = 2.0

@@ -81,7 +81,7 @@ import numpy as np
 from .. import validation
 from ..errors import PerceptionError
 from ..tolerances import (HEIGHT_MAP_CELL, HEIGHT_MAP_MARGIN, HEIGHT_MAP_OBJECT_BAND, MAX_HEIGHT_MAP_CELL, MAX_HEIGHT_MAP_CELLS,
-                          MAX_HEIGHT_MAP_MARGIN, MIN_HEIGHT, SENSOR_RANGE, STEADY_REACH_CELLS)
+                          HOLE_BORDER_REACH, MAX_HEIGHT_MAP_MARGIN, MIN_HEIGHT, SENSOR_RANGE, STEADY_REACH_CELLS)
 from ._pixels import dilate
 from ._ray_kernels import ray_bounds, shadow_bounds
 from .camera import Intrinsics, as_depth, check_intrinsics, denoised_at, denoised_depth, pixel_points_at, valid_depth
@@ -268,9 +268,18 @@ class HeightMap:
         rays = np.maximum(ray_bounds(self.heights, start, -unit, r, across, origin, cell, height, diagonal,
                                      float(out[seen].min())), 0.0)
         shadow = shadow_bounds(self.heights, start, unit, r, reach, steps, origin, cell, height, diagonal, top, rays)
-        shadow = np.where(shadow > -MIN_HEIGHT, np.maximum(shadow, 0.0), top)
+        shadow = np.where(shadow > -MIN_HEIGHT, np.maximum(shadow, 0.0), self._hole_tops(rows, cols, top))
         out[rows, cols] = np.minimum(shadow, rays)
         return out
+
+    def _hole_tops(self, rows, cols, top: float) -> np.ndarray:
+        """(n,) float: per unseen cell (rows, cols), the highest seen height within ``HOLE_BORDER_REACH`` of it;
+        ``top`` for a cell farther from every seen cell (the inside of a wide hole)."""
+        reach = max(int(math.ceil(HOLE_BORDER_REACH / self.cell - 1e-9)), 1)
+        seen = np.where(self.seen, self.heights, -np.inf).astype(np.float32)
+        near = cv2.dilate(seen, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * reach + 1, 2 * reach + 1)),
+                          borderType=cv2.BORDER_REPLICATE)[rows, cols].astype(float)
+        return np.where(np.isfinite(near), near, top)
 
 
 def height_map(

@@ -21,9 +21,11 @@ PrimeSense frames it is far nearer to the hand-made masks than the RGB steps
 colour image, the flat parts are added by colour. The RGB steps are used when
 there is no depth image, no table plane (:class:`SegmentationError` of kind
 ``"no-plane"``), or nothing of size stands above the table (kinds
-``"no-object"``, ``"tiny"``: a flat object); the segmentation then carries a
-warning that says why. A region that touches the border is refused, not
-handed to RGB.
+``"no-object"``, ``"tiny"``: a flat object), and when every region standing
+above the table touches the image border (a robot's arm or fingers in view
+beside a flat object): the RGB steps then look for a region wholly in view,
+and where they find none the depth's refusal (``"not-visible"``) stands. The
+segmentation then carries a warning that says why.
 """
 
 from __future__ import annotations
@@ -125,6 +127,14 @@ def segment(
     try:
         seen, d = seen_above_table(depth, intrinsics, **seen_options)
     except SegmentationError as err:
+        if err.kind == "not-visible":  # only regions cut by the border stand up: a robot's arm, its fingers
+            try:
+                result = segment_rgb(rgb, **rgb_options)
+            except SegmentationError:
+                raise err from None
+            note = f"depth saw only regions touching the image border ({err}); used the RGB method instead"
+            warnings.warn(note, PerceptionWarning, stacklevel=2)
+            return replace(result, warnings=(note, *result.warnings))
         if err.kind not in _DEPTH_FALLBACK_KINDS:
             raise
         note = f"depth segmentation failed ({err}); used the RGB method instead"
