@@ -232,3 +232,53 @@ def test_a_neighbour_keeps_its_height_and_a_sheet_lower_than_min_height_is_table
     np.testing.assert_allclose(hm.at([[-0.08, 0.05]]), 0.03, atol=1e-3)
     assert hm.obstacles[hm.cell_index([[-0.08, 0.05]])[:2]].all()
     assert hm.at([[0.09, 0.06]])[0] == 0.0  # 6 mm: below the segmentation's MIN_HEIGHT, read as the table
+
+
+
+def pixel_cells(hm, table, metric, v, u):
+    """(rows, cols, inside) of the map's cells under pixels (v, u) of the table."""
+    xy = (table_points(CAMERA, table, np.asarray(v), np.asarray(u)) - metric.origin) @ metric.R_camera_plane[:, :2]
+    return hm.cell_index(xy)
+
+
+def test_a_lone_noisy_reading_is_no_obstacle_and_a_patch_as_high_is_one():
+    # One reading 2 cm up on the bare table (a noise spike): the table; 5 x 5 readings as high (a small thing): an
+    # obstacle at its height.
+    depth, table, seg, metric, _ = scene(height=0.05, centre=(0.02, -0.03))
+    cv, cu = (int(c) for c in np.argwhere(seg.mask).mean(axis=0))
+    spiked = depth.copy()
+    spiked[cv - 60, cu] -= 0.02
+    spiked[cv + 58:cv + 63, cu - 62:cu - 57] -= 0.02
+    hm = height_map(spiked, CAMERA, table, metric, seg.mask, margin=0.12)
+    r, c, inside = pixel_cells(hm, table, metric, [cv - 60, cv + 60], [cu, cu - 60])
+    assert inside.all()
+    assert hm.heights[r[0], c[0]] <= 0.0 and not hm.obstacles[r[0], c[0]]
+    assert hm.heights[r[1], c[1]] == pytest.approx(0.02, abs=2e-3) and hm.obstacles[r[1], c[1]]
+
+
+def test_a_dropout_beside_a_low_object_is_bounded_by_it_not_by_a_tall_thing_elsewhere():
+    # A 3 px ring of missing readings round a 5 cm box (a sensor's edge dropouts), and a 25 cm post 10 cm from it: the
+    # ring is no higher than the box (it was the post's height), while the inside of a wide hole is not the table.
+    depth, table, seg, metric, _ = scene(height=0.05, centre=(0.02, -0.03))
+    post, _, _, _ = render(kind="box", radius=0.01, height=0.25, centre=(-0.1, -0.03))
+    ring = np.zeros(depth.shape, bool)
+    rows, cols = np.nonzero(seg.mask)
+    ring[rows.min() - 3:rows.max() + 4, cols.min() - 3:cols.max() + 4] = True
+    ring &= ~seg.mask
+    cv, cu = int(rows.mean()), int(cols.mean())
+    wide = np.zeros(depth.shape, bool)
+    wide[cv + 50:cv + 110, cu - 30:cu + 30] = True  # 8 cm of table without readings
+    hm = height_map(np.where(ring | wide, 0.0, np.minimum(depth, post)), CAMERA, table, metric, seg.mask, margin=0.2)
+    bound = hm.conservative()
+
+    def unseen(mask):
+        r, c, inside = pixel_cells(hm, table, metric, *np.nonzero(mask))
+        keep = inside & ~hm.seen[r, c]
+        assert keep.sum() > 20
+        return r[keep], c[keep]
+
+    assert bound[unseen(ring)].max() <= 0.05 + 1e-3
+    inner = np.zeros(depth.shape, bool)
+    inner[cv + 65:cv + 95, cu - 15:cu + 15] = True
+    # 15-45 px (2-6 cm) inside the wide hole: not the table beside it, but the post's height or the rays over it
+    assert bound[unseen(inner)].min() > 0.1 and np.nanmax(hm.heights) > 0.2

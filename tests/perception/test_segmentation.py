@@ -33,6 +33,24 @@ def test_auto_falls_back_to_rgb_without_a_table():
     assert iou(seg.mask, truth) > 0.95
 
 
+
+def test_an_arm_at_the_border_beside_a_flat_object_hands_over_to_rgb_and_alone_is_refused():
+    # Depth sees only an arm entering through the image's top border (a robot in view); the object lying flat is
+    # below the height depth segments at. The RGB steps find the object wholly in view; without one, depth's
+    # refusal stands.
+    depth, rgb, truth, _ = render(kind="box", height=0.004)
+    arm = np.zeros((H, W), bool)
+    arm[:40, 10:60] = True
+    depth = np.where(arm, 0.45, depth)
+    rgb = np.where(arm[..., None], np.uint8(90), rgb)
+    with pytest.warns(PerceptionWarning, match="touching the image border"):
+        seg = segment(rgb, depth, CAMERA)
+    assert seg.method == "rgb" and iou(seg.mask, truth) > 0.9
+    _, blank, _, _ = render(kind="none")
+    with pytest.raises(SegmentationError, match="not completely visible") as err:
+        segment(np.where(arm[..., None], np.uint8(90), blank), depth, CAMERA)
+    assert err.value.kind == "not-visible"
+
 def test_auto_on_a_blank_table_says_no_object():
     depth, rgb, _, _ = render(kind="none")
     with warnings.catch_warnings():
