@@ -10,7 +10,8 @@ from contourgrasp.sim import (SENSORS, Camera, build_scene, hand_pose_from_matri
                               render_view, tilted_view)
 from contourgrasp.sim.objects import flat_tool
 from contourgrasp.sim.planners import make_planner
-from contourgrasp.sim.scene import R_WORLD_CAMERA, ROBOT_ARM, Workspace
+from contourgrasp.sim import ROBOT_ARM
+from contourgrasp.sim.scene import R_WORLD_CAMERA, Workspace
 
 TILT = np.radians(12.7)
 

@@ -31,14 +31,14 @@ from .objects import THESIS_OBJECTS, ObjectSpec, Part, mesh_object, object_spec
 from .render import (BIN_LABEL, DEFAULT_SENSOR, SENSORS, Sensor, object_truth, render, render_view, sensor_named,
                      tilted_view, truth_labels)
 from ..perception import Intrinsics
-from .scene import SR300, Bin, Camera, Placement, Scene, Workspace, build_scene
+from .scene import ROBOT_ARM, SR300, Bin, Camera, Placement, Scene, Workspace, build_scene
 from .clutter import SCENE_KINDS, Arrangement, arrange, build_clutter, target_pixel
 from .trial import (DROPPED, FAILURE_CAUSES, HIT, MISSED, NO_PLAN, PUSHED, SLIPPED, STRUCK, Execution, GraspOutcome,
                     TrialRecord, execute_grasp, hand_pose_from_matrix, pose_matrix, run_trial, scripted_grasp)
 
 __all__ = [
     "Arrangement", "BIN_LABEL", "Bin", "HIT", "SCENE_KINDS", "arrange", "build_clutter", "target_pixel", "truth_labels",
-    "Camera", "ChainRule", "DEFAULT_SENSOR", "DROPPED", "SENSORS", "Sensor", "Execution", "FAILURE_CAUSES", "FingerTiming", "GraspOutcome", "HandDesign",
+    "Camera", "ChainRule", "DEFAULT_SENSOR", "DROPPED", "ROBOT_ARM", "SENSORS", "Sensor", "Execution", "FAILURE_CAUSES", "FingerTiming", "GraspOutcome", "HandDesign",
     "HandModel", "Intrinsics", "MISSED", "NO_PLAN", "ObjectSpec", "PUSHED", "Part", "Placement", "SLIPPED", "SR300", "STRUCK",
     "Scene", "THESIS_OBJECTS", "TIMINGS", "TrialRecord", "Workspace", "build_hand", "build_scene", "derive_body", "execute_grasp",
     "fingertip_path_error", "fingertip_paths", "hand_pose_from_matrix", "mesh_object", "object_spec", "object_truth",
