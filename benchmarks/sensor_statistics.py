@@ -10,8 +10,9 @@ folders: ``../shared/data/README.md`` names each one's sensor), on the support s
   of :class:`contourgrasp.sim.Sensor` (sigma = k d^2); and the same with the heights above the
   fitted support plane (within 1 cm of it) for the reading less its neighbours: the scatter a
   sensor whose matcher smooths its depth over a few pixels shows only against the surface;
-- **edge dropout**: of the pixels within ``EDGE_PX`` of a depth edge (a jump of more than
-  ``EDGE_STEP`` between valid readings of a 9 x 9 window), the share that read nothing;
+- **edge dropout**: of the pixels within ``DOCTOR_EDGE_PX`` (3) of a depth edge (a jump of more than
+  ``DOCTOR_EDGE_STEP``, 2 cm, between valid readings of a 9 x 9 window:
+  :func:`contourgrasp.doctor.near_depth_edges`), the share that read nothing;
 - **speckle**: of the support's pixels away from edges (its outline filled), the share that read
   nothing;
 - **missing**: the frame's whole missing share.
@@ -41,14 +42,11 @@ import cv2
 import numpy as np
 
 from contourgrasp import perception
+from contourgrasp.doctor import near_depth_edges
 from contourgrasp.errors import ContourGraspError
 from contourgrasp.io.camera_file import frame_files, read_masked_frames, read_rgbd
 
 SHARED_DATA = Path(os.environ.get("CONTOURGRASP_SHARED_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
-#: A depth edge: valid readings of a 9 x 9 window more than this apart (m) ...
-EDGE_STEP = 0.02
-#: ... and the pixels within this many of it.
-EDGE_PX = 3
 #: Depth bands for the noise, m.
 BAND = 0.05
 #: Residuals beyond this (m) are outliers, not noise.
@@ -78,15 +76,6 @@ def rendered(scenes: int):
             yield f"simulated `{preset}`", render(scene, sensor=preset, seed=k)[1], scene.camera.intrinsics
 
 
-def near_edges(depth, missing) -> np.ndarray:
-    """(H, W) bool: pixels within ``EDGE_PX`` of a depth edge between valid readings."""
-    window = np.ones((9, 9), np.uint8)
-    high = cv2.dilate(np.where(missing, 0.0, depth).astype(np.float32), window)
-    low = -cv2.dilate(np.where(missing, -np.inf, -depth).astype(np.float32), window)
-    edge = (high - low) > EDGE_STEP
-    return cv2.dilate(edge.astype(np.uint8), np.ones((2 * EDGE_PX + 1,) * 2, np.uint8)) > 0
-
-
 def noise_k(depth, support, height=None) -> float:
     """Median over depth bands of (std of a reading less its 5 x 5 median, on the support) / depth^2; with ``height``
     (the readings' heights above the support plane) the std of those heights instead."""
@@ -107,7 +96,7 @@ def noise_k(depth, support, height=None) -> float:
 def statistics(depth, intrinsics) -> dict:
     missing = ~(np.isfinite(depth) & (depth > 0))
     d = np.where(missing, 0.0, depth)
-    edges = near_edges(d, missing)
+    edges = near_depth_edges(d, missing)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         filled, _ = perception.fill_depth_holes(d, max_hole_px=0)

@@ -130,7 +130,7 @@ def diagnose(rgb, depth, intrinsics: Intrinsics, hand: Hand, *, colour_intrinsic
     intrinsics.check_shape(d.shape, "depth image")
     findings = [_depth_finding(d, intrinsics)]
     missing = ~perception.valid_depth(d)
-    edge_missing = _beside_edges(d, missing)
+    edge_missing = missing & near_depth_edges(d, missing)
     findings.append(_missing_finding(missing, edge_missing))
     findings.append(_intrinsics_finding(intrinsics))
     on_depth = None
@@ -164,16 +164,15 @@ def _depth_finding(depth: np.ndarray, intrinsics: Intrinsics) -> Finding:
     return Finding("depth", text, "warning" if outside > 0.5 else "ok")
 
 
-def _beside_edges(depth: np.ndarray, missing: np.ndarray) -> np.ndarray:
-    """(H, W) bool: the missing pixels within ``DOCTOR_EDGE_PX`` of a place where the valid readings of a 9 x 9
-    window differ by more than ``DOCTOR_EDGE_STEP``: the holes beside a depth edge."""
-    d = np.where(missing, np.nan, depth)
+def near_depth_edges(depth: np.ndarray, missing: np.ndarray) -> np.ndarray:
+    """(H, W) bool: the pixels within ``DOCTOR_EDGE_PX`` of a place where the valid readings (not ``missing``) of
+    a 9 x 9 window differ by more than ``DOCTOR_EDGE_STEP``: beside a depth edge, where sensors drop readings
+    (also ``benchmarks/sensor_statistics.py``'s edge dropout)."""
     window = np.ones((9, 9), np.uint8)
-    filled = cv2.dilate(np.nan_to_num(d, nan=0.0).astype(np.float32), window)
-    low = -cv2.dilate(np.where(missing, -np.inf, -d).astype(np.float32), window)
-    step = (filled - low) > tol.DOCTOR_EDGE_STEP
-    near = cv2.dilate(step.astype(np.uint8), np.ones((2 * tol.DOCTOR_EDGE_PX + 1,) * 2, np.uint8)) > 0
-    return missing & near
+    high = cv2.dilate(np.where(missing, 0.0, depth).astype(np.float32), window)
+    low = -cv2.dilate(np.where(missing, -np.inf, -depth).astype(np.float32), window)
+    step = (high - low) > tol.DOCTOR_EDGE_STEP
+    return cv2.dilate(step.astype(np.uint8), np.ones((2 * tol.DOCTOR_EDGE_PX + 1,) * 2, np.uint8)) > 0
 
 
 def _missing_finding(missing: np.ndarray, edge_missing: np.ndarray) -> Finding:
