@@ -15,7 +15,8 @@ from scipy import ndimage
 
 from .. import validation
 from ..errors import PerceptionError
-from ..tolerances import (FOOTPRINT_CELL, HIDDEN_SIDE_TILT, FOOTPRINT_CLOSE, FOOTPRINT_MAX_CELLS, MAX_HOLE_PX, MIN_AREA_PX, MIN_HEIGHT, MIN_TABLE_HOLE_PX, PLANE_THRESHOLD, SENSOR_RANGE,
+from ..tolerances import (FOOTPRINT_CELL, FOOTPRINT_CLOSE, FOOTPRINT_MAX_CELLS, HIDDEN_SIDE_TILT, MAX_HOLE_PX,
+                          MIN_AREA_PX, MIN_HEIGHT, MIN_TABLE_HOLE_PX, PLANE_THRESHOLD, SENSOR_RANGE,
                           TILT_PLANE_THRESHOLD)
 from ._frame import memoised
 from ._pixels import check_pixel, disc, grown_box, in_image, pixel_box

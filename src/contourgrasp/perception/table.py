@@ -295,8 +295,7 @@ def plane_axes(normal) -> np.ndarray:
 
 def table_points(intrinsics: Intrinsics, plane: Plane, rows, cols) -> np.ndarray:
     """(..., 3) float: where the rays of pixels (rows, cols) meet ``plane``; NaN where they miss it (behind the camera)."""
-    rays = np.stack([(cols - intrinsics.cx) / intrinsics.fx, (rows - intrinsics.cy) / intrinsics.fy,
-                     np.ones(np.shape(rows))], axis=-1)
+    rays = intrinsics.rays(np.stack(np.broadcast_arrays(cols, rows), axis=-1)).reshape(*np.shape(rows), 3)
     with np.errstate(divide="ignore", invalid="ignore"):
         reach = -plane.offset / (rays @ plane.normal)
     reach = np.where(reach > 0, reach, np.nan)

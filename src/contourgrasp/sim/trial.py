@@ -193,7 +193,8 @@ class TrialRecord:
 
 
 def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finger-linear",
-              sensor: Sensor | str = DEFAULT_SENSOR, tilt: float | None = None, timing: str = "thesis", design: HandDesign = HandDesign(), camera: Camera = Camera(),
+              sensor: Sensor | str = DEFAULT_SENSOR, tilt: float | None = None, timing: str = "thesis",
+              design: HandDesign = HandDesign(), camera: Camera = Camera(),
               workspace: Workspace = Workspace(), execution: Execution = Execution(), observe=None,
               scene_kind: str = "single", pool=(), robot: bool = False) -> TrialRecord:
     """Place the object (seeded), take an RGB-D picture, plan, execute, and record the outcome.
