@@ -492,7 +492,8 @@ def _plan_all(args, frame, options, extrinsics) -> int:
 
     if frame.mask is not None or options.perception.segment == "rgb":
         raise InputError("--all plans every depth candidate: not with --mask or --segment rgb")
-    candidates = find_objects(frame.depth, frame.intrinsics, fill_holes=options.perception.fill_holes).candidates
+    candidates = find_objects(frame.depth, frame.intrinsics, rgb=frame.rgb, fill_holes=options.perception.fill_holes,
+                              colour_offset_px=options.perception.colour_offset_px).candidates
     choose_target(candidates)  # refuses, in one line, an empty scene or one whose every region touches the border
     inner = [c for c in candidates if c.in_view]
     if len(inner) > MAX_ALL_OBJECTS:

@@ -138,7 +138,7 @@ def diagnose(rgb, depth, intrinsics: Intrinsics, hand: Hand, *, colour_intrinsic
         on_depth = perception.colour_on_depth(rgb, d.shape, intrinsics=None if colour_intrinsics is None else intrinsics,
                                               colour_intrinsics=colour_intrinsics)
         findings.append(_colour_finding(np.shape(rgb), d.shape, colour_intrinsics is not None))
-    support = _support(d, intrinsics, findings)
+    support = _support(on_depth, d, intrinsics, findings)
     result = None
     if support is not None:
         findings.append(_objects_finding(support, hand))
@@ -210,9 +210,9 @@ def _colour_finding(colour_shape, depth_shape, mapped: bool) -> Finding:
     return Finding("colour", f"{w}x{h}: {how}, resampled onto the depth's grid", "note")
 
 
-def _support(depth, intrinsics, findings) -> perception.Support | None:
+def _support(rgb, depth, intrinsics, findings) -> perception.Support | None:
     try:
-        support = find_objects(depth, intrinsics)
+        support = find_objects(depth, intrinsics, rgb=rgb)
     except perception.SegmentationError as err:
         findings.append(Finding("support", f"no support plane: {err}", "warning"))
         return None
@@ -232,6 +232,9 @@ def _objects_finding(support: perception.Support, hand: Hand) -> Finding:
     fits = [c for c in inner if max(c.extent) <= perception.hand_opening(hand)]
     text = (f"{len(candidates)} standing on it: {len(inner)} wholly in view, {len(fits)} of them narrower than "
             f"{hand.name}'s opening ({1000 * perception.hand_opening(hand):.0f} mm)")
+    touching = sum(c.touching for c in candidates)
+    if touching:
+        text += f"; {touching} of them split from objects they touch (colour and surface change where they meet)"
     return Finding("objects", text, "warning" if not inner else "ok")
 
 

@@ -285,16 +285,20 @@ def palm_depth(metric: MetricContour, heights: HeightMap, hand: Hand, pose, tip_
     return float(z + metric.R_camera_plane[:, 2] @ metric.origin)
 
 
-def find_objects(depth, intrinsics: Intrinsics, *, fill_holes: bool = True) -> perception.Support:
+def find_objects(depth, intrinsics: Intrinsics, *, rgb=None, fill_holes: bool = True,
+                 colour_offset_px=None) -> perception.Support:
     """The support surface and every candidate on it, as :func:`plan_frame` finds them (``plan --all``).
 
-    The depth is checked and its small holes filled as in :func:`plan_frame`, so a candidate's
-    pixels here are its pixels there: ``plan_frame(target_px=...)`` at one of them plans on it.
+    The depth is checked and its small holes filled as in :func:`plan_frame`, and with ``rgb`` (on
+    the depth's grid) a candidate holding touching objects is split as there
+    (:func:`contourgrasp.perception.split_touching`, ``colour_offset_px`` as
+    :class:`~contourgrasp.perception.PerceptionOptions`'), so a candidate's pixels here are its
+    pixels there: ``plan_frame(target_px=...)`` at one of them plans on it.
 
     Raises
     ------
     PerceptionError
-        Bad depth or intrinsics; no support plane (SegmentationError ``"no-plane"``).
+        Bad depth, colour or intrinsics; no support plane (SegmentationError ``"no-plane"``).
     """
     check_intrinsics(intrinsics)
     validation.flag("fill_holes", fill_holes, error=PerceptionError)
@@ -303,7 +307,16 @@ def find_objects(depth, intrinsics: Intrinsics, *, fill_holes: bool = True) -> p
     if fill_holes:
         d, _ = perception.fill_depth_holes(d)
     with perception.one_frame():
-        return perception.find_support(d, intrinsics)
+        support = perception.find_support(d, intrinsics)
+        return replace(support, candidates=_split_touching(support.candidates, rgb, d, intrinsics, support.plane,
+                                                           colour_offset_px))
+
+
+def _split_touching(candidates, rgb, depth, intrinsics, plane, colour_offset_px):
+    """:func:`contourgrasp.perception.split_touching` where there is colour and a candidate."""
+    if rgb is None or not candidates:
+        return candidates
+    return perception.split_touching(candidates, rgb, depth, intrinsics, plane, colour_offset_px=colour_offset_px)
 
 
 def perceive(rgb, depth, intrinsics: Intrinsics, options: PerceptionOptions = PerceptionOptions(), *, mask=None,
@@ -366,6 +379,8 @@ def _perceive(rgb, depth, intrinsics, options: PerceptionOptions, *, mask, targe
         support = None
     plane = None if support is None else support.plane
     candidates = () if support is None else support.candidates
+    if mask is None and segment != "rgb":
+        candidates = _split_touching(candidates, rgb, d, intrinsics, plane, options.colour_offset_px)
     target, reason = None, ""
     if chosen:
         pixel_heights = None if target_px is None or plane is None else perception.table.heights(d, intrinsics, plane)
@@ -380,7 +395,7 @@ def _perceive(rgb, depth, intrinsics, options: PerceptionOptions, *, mask, targe
             depth_options["fill_holes"] = False  # d is filled already: a second pass finds the same larger holes only
         if plane is not None and segment != "rgb":
             depth_options["plane"] = plane  # the same fit segmentation would make
-        if target is not None and (chosen or target is not next(c for c in candidates if c.in_view)):
+        if target is not None and (chosen or target.touching or target is not next(c for c in candidates if c.in_view)):
             depth_options["target"] = target.mask  # else segmentation's own pick, the largest wholly visible region
         if target_px is not None:
             depth_options["target_px"] = target_px  # which of the target's footprints, where neighbours share it

@@ -150,6 +150,26 @@ MIN_AREA_PX = 200
 #: region there. A steep face seen at the bench's 25 deg tilt changes by about
 #: 3 mm a pixel; an object's top against a bin wall's, by centimetres.
 CANDIDATE_DEPTH_STEP = 0.02
+#: Touching objects (perception.split_touching): two colour clusters of a candidate are two surfaces when their
+#: chromaticities (CIELAB a, b on OpenCV's 8-bit scale) lie this far apart ...
+TOUCHING_CHROMA = 25.0
+#: ... or one's linear luminance is this many times the other's (8-bit values about 1.9 times). Shading on one
+#: surface changes it by less on the shared real frames (a mug's or a bottle's lit and shaded parts 1.4 to 2.8 times)
+#: except on black objects, whose light is mostly noise (up to 7 times): the surface test below keeps those whole.
+TOUCHING_ALBEDO_RATIO = 4.0
+#: ... and they are two objects when, in bands this wide (px) on either side of where they meet, the heights within
+#: 5 x 5 px of the median pixel span at least this much (m): one lies on or in front of the other. A two-coloured
+#: object's parts (a bottle's cap, a drill's grip) meet on one surface: 4 to 8 mm on the shared real frames.
+TOUCHING_BAND_PX = 3
+TOUCHING_STEP = 0.01
+#: ... unless the surface folds outward there (the convexity of Stein et al.'s LCCP, 0 for a step, about 0.7 for a
+#: box's top and side): a can's top and its dark side wall seen from above meet at a convex edge.
+TOUCHING_CONVEX = 0.3
+#: Each piece holds at least this share of the candidate's raised pixels (and ``MIN_AREA_PX``): a printed label's
+#: specks are no object (a banana against a heap in a bin is 11 %).
+TOUCHING_MIN_SHARE = 0.05
+#: A candidate is split into at most this many touching objects (bounds the work of a heap).
+MAX_TOUCHING_PIECES = 4
 #: A click on the support inside a container means the candidate within this many pixels of it, if one is inside.
 CLICK_REACH_PX = 20
 #: ... but only where one piece has another at least this fraction inside its filled outline (a bin's walls around an

@@ -12,7 +12,7 @@ import pytest
 
 from contourgrasp import load_hand, load_planner, perception
 from contourgrasp.io.camera_file import frame_files, read_rgbd
-from contourgrasp.pipeline import plan_frame
+from contourgrasp.pipeline import find_objects, plan_frame
 
 SHARED = Path(os.environ.get("CONTOURGRASP_SHARED_DATA", Path(__file__).resolve().parents[3] / "shared" / "data"))
 REAL = SHARED / "rgbd"
@@ -52,3 +52,32 @@ def test_a_bottle_among_twelve_objects_at_62_degrees_is_one_labelled_object():
     ids, counts = np.unique(labels[result.target.mask & (labels > 0)], return_counts=True)
     assert counts.max() > 0.8 * result.target.mask.sum()
     assert iou(result.target.mask, labels == ids[np.argmax(counts)]) > 0.7
+
+
+def objects(name):
+    colour, depth, intrinsics = frame_files(REAL / name)
+    frame = read_rgbd(colour, depth, intrinsics)
+    rgb = perception.colour_on_depth(frame.rgb, frame.depth.shape, intrinsics=frame.intrinsics,
+                                     colour_intrinsics=frame.colour_intrinsics)
+    return rgb, find_objects(frame.depth, frame.intrinsics, rgb=rgb).candidates
+
+
+def test_a_cup_behind_a_bowl_at_62_degrees_is_split_from_it():
+    # Depth joins them (the cup's wall rises behind the bowl's rim); a red bowl and a yellow cup, 2 cm apart in depth.
+    labels = cv2.imread(str(REAL / "real_m2t2_realworld_00" / "seg.png"), cv2.IMREAD_UNCHANGED)
+    _, found = objects("real_m2t2_realworld_00")
+    bowl, cup = labels == 105, labels == 107
+    shares = [((c.mask & bowl).sum() / c.mask.sum(), (c.mask & cup).sum() / c.mask.sum()) for c in found if c.in_view]
+    assert max(b for b, _ in shares) > 0.7 and max(c for _, c in shares) > 0.7
+    assert all(min(pair) < 0.1 for pair in shares)
+
+
+def test_a_clamp_lying_across_a_white_pack_is_split_from_it_and_one_object_is_not():
+    rgb, found = objects("real_gqcnn_primesense_clutter_0")
+    pieces = [c for c in found if c.touching]
+    assert len(pieces) == 2
+    grey = rgb.mean(axis=2)
+    light, dark = sorted(pieces, key=lambda c: -np.median(grey[c.mask]))
+    assert np.median(grey[light.mask]) > 120 > 80 > np.median(grey[dark.mask])
+    assert dark.height > light.height + 0.01  # the clamp's arm lies on the pack
+    assert not any(c.touching for c in objects("real_6dofgraspnet_blue_mug")[1])  # inside and outside of one mug

@@ -14,6 +14,8 @@ One module per stage, in the order the pipeline runs them:
 * :mod:`~contourgrasp.perception.segment_depth` -- the region above the table, its footprint
 * :mod:`~contourgrasp.perception.candidates` -- every region standing on the table
   (:class:`Candidate`), the target to grasp among them
+* :mod:`~contourgrasp.perception.touching` -- a candidate that holds touching objects split where
+  colour and surface both change
 * :mod:`~contourgrasp.perception.support` -- the support surface (a table or a bin's floor), the
   candidates standing on it (:class:`Support`)
 * :mod:`~contourgrasp.perception.colour` -- colour-depth registration, flat parts found by colour
@@ -49,11 +51,12 @@ from .segment_rgb import segment_rgb
 from .segmentation import SEGMENT_METHODS, SegmentMethod, segment, segment_from_mask
 from .support import Support, find_support
 from .table import Plane, fit_plane, fit_table_plane
+from .touching import split_touching
 
 __all__ = [
     "Candidate", "DEPTH_MODES", "DepthMode", "HeightMap", "Intrinsics", "MetricContour", "PerceptionError", "PerceptionOptions", "PerceptionWarning", "Plane",
     "SEGMENT_METHODS", "SegmentMethod", "Segmentation", "SegmentationError", "Support", "TARGET_RULES", "add_flat_parts", "approach_depth",
     "as_depth", "backproject", "choose_target", "colour_on_depth", "colour_offset", "contour_to_metric", "denoised_depth", "fill_depth_holes",
     "cross_section", "find_candidates", "find_support", "fit_plane", "fit_table_plane", "hand_opening", "height_map", "hidden_side", "low_part_candidate", "mask_contour", "object_footprint", "one_frame", "open_table_holes", "register_colour", "segment",
-    "segment_depth", "segment_from_mask", "segment_rgb", "valid_depth",
+    "segment_depth", "segment_from_mask", "segment_rgb", "split_touching", "valid_depth",
 ]

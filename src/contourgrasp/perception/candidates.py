@@ -72,6 +72,9 @@ class Candidate:
         Length and width (length >= width) of the outline's minimum-area
         rectangle, m, at the region's median depth (pixels x depth / fx):
         the size a hand must span, to a few percent on a tilted camera.
+    touching : bool
+        Split from a region it shared with an object it touches
+        (:func:`~contourgrasp.perception.touching.split_touching`).
     """
 
     label: int
@@ -83,6 +86,7 @@ class Candidate:
     bbox: tuple[int, int, int, int]
     in_view: bool
     extent: tuple[float, float] = (0.0, 0.0)
+    touching: bool = False
 
 
 def find_candidates(
@@ -155,6 +159,24 @@ def find_candidates(
                                (float(centroids[i, 0]), float(centroids[i, 1])), (x, y, w, hh), not bool(touching[i]),
                                _extent(contour, d[box][labels[box] == i], intrinsics)))
     return tuple(found)
+
+
+def candidate_from_mask(mask, depth, pixel_heights, intrinsics: Intrinsics, label: int, *,
+                        min_height: float = MIN_HEIGHT, within=np.s_[:, :]) -> Candidate:
+    """The wholly visible :class:`Candidate` ``label`` whose mask is ``mask`` ((H, W) bool, not empty, inside the
+    slices ``within``), as :func:`find_candidates` describes its regions: its pixels more than ``min_height``
+    above the support (``pixel_heights``, m) are what stands up."""
+    y, x = ndimage.find_objects(mask[within].astype(np.uint8))[0]
+    y0, x0 = within[0].start or 0, within[1].start or 0
+    y, x = slice(y.start + y0, y.stop + y0), slice(x.start + x0, x.stop + x0)
+    with np.errstate(invalid="ignore"):
+        raised = mask[y, x] & (pixel_heights[y, x] > min_height)
+    rows, cols = np.nonzero(raised if raised.any() else mask[y, x])
+    rows, cols = rows + y.start, cols + x.start
+    contour = mask_contour(mask)
+    return Candidate(label, mask, contour, int(raised.sum()), float(np.nanmax(pixel_heights[rows, cols])),
+                     (float(cols.mean()), float(rows.mean())), (x.start, y.start, x.stop - x.start, y.stop - y.start),
+                     True, _extent(contour, depth[rows, cols], intrinsics))
 
 
 def split_at_depth_steps(above, depth, min_area_px: int, *, focal=None):

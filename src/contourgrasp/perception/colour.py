@@ -55,6 +55,7 @@ def add_flat_parts(
     height_sigmas: float = FLAT_HEIGHT_SIGMAS,
     min_height: float = MIN_HEIGHT,
     min_area_px: int = MIN_AREA_PX,
+    others=None,
 ) -> Segmentation:
     """Add to a depth segmentation the parts of the object too flat for depth to see.
 
@@ -136,6 +137,10 @@ def add_flat_parts(
         Height (m) from which a pixel stands on the table, as in :func:`segment_depth`.
     min_area_px : int
         Smallest flat part, smallest piece joined and smallest object, pixels.
+    others : (H, W) bool, optional
+        Pixels of other objects, which are no part of this one: the objects it touches, split
+        from it (:func:`~contourgrasp.perception.split_touching`), stand out from the table's
+        colour as much as a flat part does.
 
     Returns
     -------
@@ -166,6 +171,9 @@ def add_flat_parts(
     unlike = _unlike_table(image, seg.mask, halo, seg.plane.inliers, height, _Evidence(
         colour_distance, lightness_weight, shadow_lightness, halo_px, gap_px if grey else 0, height_sigmas, min_height,
         min_area_px))
+    if others is not None:
+        validation.same_size(np.shape(others), seg.mask.shape, "others", "mask", error=PerceptionError)
+        unlike &= ~np.asarray(others, dtype=bool)
     _, labels, areas = components(unlike & ~halo)
     large = areas >= min_area_px
     large[0] = False

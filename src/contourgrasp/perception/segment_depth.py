@@ -19,7 +19,7 @@ from ..tolerances import (FOOTPRINT_CELL, FOOTPRINT_CLOSE, FOOTPRINT_MAX_CELLS, 
                           MIN_AREA_PX, MIN_HEIGHT, MIN_TABLE_HOLE_PX, PLANE_THRESHOLD, SENSOR_RANGE,
                           TILT_PLANE_THRESHOLD)
 from ._frame import memoised
-from ._pixels import check_pixel, disc, grown_box, in_image, pixel_box
+from ._pixels import check_pixel, connected_to, disc, grown_box, in_image, pixel_box
 from .camera import Intrinsics, as_depth, check_intrinsics, fill_depth_holes, pixel_points, valid_depth
 from .region import Segmentation, make_segmentation, pick_object
 from .table import Plane, fit_table_plane, footprint_pixels, heights, plane_axes, table_points
@@ -103,15 +103,17 @@ def segment_depth(
     SegmentationError
         No table plane, nothing above it, the object touches the border, or it is tiny.
     """
-    seen, d = seen_above_table(depth, intrinsics, min_height=min_height, plane=plane, fill_holes=fill_holes,
-                                max_hole_px=max_hole_px, min_area_px=min_area_px, depth_range=depth_range, seed=seed,
-                                target=target)
+    seen, d, _ = seen_above_table(depth, intrinsics, min_height=min_height, plane=plane, fill_holes=fill_holes,
+                                   max_hole_px=max_hole_px, min_area_px=min_area_px, depth_range=depth_range,
+                                   seed=seed, target=target)
     return with_footprint(seen, d, intrinsics, footprint, min_area_px, target_px=target_px)
 
 
 def seen_above_table(depth, intrinsics, *, min_height, plane, fill_holes, max_hole_px, min_area_px, depth_range, seed,
                      target=None):
-    """:func:`segment_depth` without the footprint: the region seen above the table, and the hole-filled depth."""
+    """:func:`segment_depth` without the footprint: the region seen above the table, the hole-filled depth, and
+    (H, W) bool the raised pixels joined to the ``target`` in the view but not in it: the objects it touches
+    (:func:`~contourgrasp.perception.split_touching`; none without a target)."""
     d = as_depth(depth)
     check_intrinsics(intrinsics).check_shape(d.shape, "depth image")
     if plane is not None and not isinstance(plane, Plane):
@@ -126,11 +128,14 @@ def seen_above_table(depth, intrinsics, *, min_height, plane, fill_holes, max_ho
     if plane is None:
         plane = fit_table_plane(d, intrinsics, depth_range=depth_range, seed=seed)
     above, dead_band = raised_pixels(d, intrinsics, plane, min_height=min_height, depth_range=depth_range)
+    touched = np.zeros(above.shape, dtype=bool)
     if target is not None and np.shape(target) == above.shape:  # (a wrong shape: pick_object's error)
-        above = above & np.asarray(target, dtype=bool)  # a candidate is split from what it touches (find_candidates)
+        target = np.asarray(target, dtype=bool)
+        touched = connected_to(above, above & target) & ~target
+        above = above & target  # a candidate is split from what it touches (find_candidates, split_touching)
     mask, notes = pick_object(above, dead_band, min_area_px,
                                f"more than {min_height * 1000:.0f} mm above the table", target=target)
-    return make_segmentation("depth", mask, notes, plane=plane, filled_px=filled), d
+    return make_segmentation("depth", mask, notes, plane=plane, filled_px=filled), d, touched
 
 
 def raised_pixels(depth, intrinsics: Intrinsics, plane: Plane, *, min_height: float = MIN_HEIGHT,

@@ -125,7 +125,7 @@ def segment(
     seen_options = {**validation.keyword_defaults(segment_depth), **depth_options}
     footprint, target_px = seen_options.pop("footprint"), seen_options.pop("target_px")
     try:
-        seen, d = seen_above_table(depth, intrinsics, **seen_options)
+        seen, d, touched = seen_above_table(depth, intrinsics, **seen_options)
     except SegmentationError as err:
         if err.kind == "not-visible":  # only regions cut by the border stand up: a robot's arm, its fingers
             try:
@@ -142,7 +142,7 @@ def segment(
         if offset is None:
             offset = colour_offset(rgb, d, seen.mask)
         grown = add_flat_parts(register_colour(rgb, offset), seen, d, intrinsics,
-                               **{"min_height": seen_options["min_height"], **colour_options})
+                               **{"min_height": seen_options["min_height"], "others": touched, **colour_options})
         return with_footprint(replace(grown, colour_offset_px=offset), d, intrinsics, footprint,
                                seen_options["min_area_px"], target_px=target_px)
     result = segment_rgb(rgb, **rgb_options)
