@@ -118,11 +118,12 @@ FOOTPRINT_CELL = 0.0005
 #: The seen points' footprints are joined by closing with a disc of this radius (m): a pixel's width on the table
 #: at 1 m with a 525 px focal length, twice over.
 FOOTPRINT_CLOSE = 0.004
-#: Above this tilt (rad) the footprint's hidden far side is completed by the object's visual hull
-#: (perception.segment_depth.hidden_side): a band h tan(tilt) behind an object of height h is hidden, 0.58 h at
-#: 30 deg; below it the top seen bounds the far side, and the hull would close the gaps between touching
-#: neighbours and the concavities in an object's own shadow.
-HIDDEN_SIDE_TILT = _radians(30.0)
+#: From the first tilt (rad) to the second the footprint's hidden far side is completed by a visual hull whose column
+#: grows from infinitely tall (nothing added) to as tall as the object is seen (perception.segment_depth.hidden_side):
+#: a band h tan(tilt) behind an object of height h is hidden, 0.58 h at 30 deg. Below, the top seen bounds the far
+#: side, and the hull would close the gaps between touching neighbours and the concavities in an object's own
+#: shadow. A ramp, not a threshold: a camera near one would get the hull in one frame and not in the next.
+HIDDEN_SIDE_TILTS = (_radians(25.0), _radians(35.0))
 #: At most this many grid cells (a larger footprint gets coarser cells: the work a frame can ask for is bounded).
 FOOTPRINT_MAX_CELLS = 4_000_000
 

@@ -8,7 +8,8 @@ import pytest
 from scipy import ndimage
 
 from contourgrasp.errors import SegmentationError
-from contourgrasp.perception import Plane, hidden_side, segment_depth
+from contourgrasp.perception import Plane, hidden_side, object_footprint, segment_depth
+from contourgrasp.perception.segment_depth import hidden_side_weight
 from perception_scenes import CAMERA, render, render_footprint, iou
 
 
@@ -115,3 +116,20 @@ def test_the_hidden_side_is_the_visual_hull_as_tall_as_the_object(kind):
     assert (added & ~ndimage.binary_dilation(base, iterations=2)).sum() < 0.02 * added.sum()
     hidden = base & seen  # the base's pixels that see the object, not the table
     assert (added & hidden).sum() > 0.8 * hidden.sum()
+
+
+def test_the_hidden_side_grows_with_the_tilt_and_no_tilt_switches_it_on():
+    # A 6 cm can seen from 24 to 36 deg whose far half returned no readings (as a RealSense's far wall does):
+    # its footprint grows from the near half to the whole base smoothly; across 30 deg (where a threshold stood)
+    # it changes by a few pixels, not by the hidden band.
+    match = {}
+    for tilt in (24.0, 29.9, 30.1, 33.0, 36.0):
+        depth, _, seen, normal = render(kind="cylinder", tilt_deg=tilt, radius=0.03, height=0.06)
+        rows = np.nonzero(seen)[0]
+        depth[seen & (np.arange(seen.shape[0])[:, None] < np.median(rows))] = np.nan
+        footprint = object_footprint(seen, depth, CAMERA, Plane(normal=normal, offset=0.7))
+        match[tilt] = iou(footprint, render_footprint(kind="cylinder", tilt_deg=tilt, radius=0.03))
+    assert match[24.0] < 0.3 and match[36.0] > 0.9
+    assert match[30.1] < match[33.0] < match[36.0]
+    assert abs(match[30.1] - match[29.9]) < 0.1
+    assert hidden_side_weight(np.radians(30.0)) == pytest.approx(0.5)

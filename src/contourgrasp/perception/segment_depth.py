@@ -15,7 +15,7 @@ from scipy import ndimage
 
 from .. import validation
 from ..errors import PerceptionError
-from ..tolerances import (FOOTPRINT_CELL, FOOTPRINT_CLOSE, FOOTPRINT_MAX_CELLS, HIDDEN_SIDE_TILT, MAX_HOLE_PX,
+from ..tolerances import (FOOTPRINT_CELL, FOOTPRINT_CLOSE, FOOTPRINT_MAX_CELLS, HIDDEN_SIDE_TILTS, MAX_HOLE_PX,
                           MIN_AREA_PX, MIN_HEIGHT, MIN_TABLE_HOLE_PX, PLANE_THRESHOLD, SENSOR_RANGE,
                           TILT_PLANE_THRESHOLD)
 from ._frame import memoised
@@ -285,15 +285,18 @@ def object_footprint(mask, depth, intrinsics: Intrinsics, plane: Plane) -> np.nd
        pixel's width on the table (the outermost points seen lie up to a
        pixel inside the object's edge): the *seen footprint*. Where the top
        is seen (most objects, at most tilts), its outline bounds the far side.
-    2. Above ``HIDDEN_SIDE_TILT`` (30 deg) much of the far side is hidden, and
-       holes in the readings (40 % of a 62 deg RealSense frame) leave the seen
-       footprint open there: the table points hidden behind the object that lie
-       in its visual hull, as tall as it is seen, are added
-       (:func:`hidden_side`). A mug at 62 deg whose far wall returned no
-       readings is whole. Below that tilt the top seen bounds the far side,
-       and the hull would close the hidden gap between touching neighbours and
-       the concavities in an object's own shadow (between a tool's head and
-       handle): the rule is not applied.
+    2. At large tilts much of the far side is hidden, and holes in the
+       readings (40 % of a 62 deg RealSense frame) leave the seen footprint
+       open there: the table points hidden behind the object that lie in its
+       visual hull are added (:func:`hidden_side`), the hull of a column as
+       tall as the object is seen from ``HIDDEN_SIDE_TILTS[1]`` (35 deg) up, and
+       from ``HIDDEN_SIDE_TILTS[0]`` (25 deg) to there of one taller by the
+       factor :func:`hidden_side_weight` divides by (twice as tall at 30 deg),
+       which adds less of the hidden band: no tilt switches it on or off. A
+       mug at 62 deg whose far wall returned no readings is whole. Below 25 deg
+       the top seen bounds the far side, and the hull would close the hidden
+       gap between touching neighbours and the concavities in an object's own
+       shadow (between a tool's head and handle): the rule is not applied.
     3. The footprint is drawn into the image: the pixels whose rays meet the
        table in it.
 
@@ -333,9 +336,23 @@ def object_footprint(mask, depth, intrinsics: Intrinsics, plane: Plane) -> np.nd
     prow, pcol = np.mgrid[box]
     inside, i, j = grid.cells(table_points(intrinsics, plane, prow, pcol) @ axes)
     out[box] = inside & seen[i, j]
-    if plane.tilt > HIDDEN_SIDE_TILT:
-        out |= hidden_side(mask, intrinsics, plane, top=float(np.percentile(plane.height(points), 95)))
+    weight = hidden_side_weight(plane.tilt)
+    if weight > 0:
+        top = float(np.percentile(plane.height(points), 95))
+        out |= hidden_side(mask, intrinsics, plane, top=top / weight)
     return out
+
+
+def hidden_side_weight(tilt: float) -> float:
+    """How much of the hidden side :func:`object_footprint` adds at a camera ``tilt`` (rad): 0 below
+    ``HIDDEN_SIDE_TILTS[0]``, 1 above ``HIDDEN_SIDE_TILTS[1]``, linear between; the visual hull's column is the
+    object's seen height divided by it.
+
+    >>> round(hidden_side_weight(np.radians(30.0)), 6), hidden_side_weight(0.1), hidden_side_weight(1.0)
+    (0.5, 0.0, 1.0)
+    """
+    low, high = HIDDEN_SIDE_TILTS
+    return float(np.clip((tilt - low) / (high - low), 0.0, 1.0))
 
 
 def hidden_side(mask, intrinsics: Intrinsics, plane: Plane, *, top: float) -> np.ndarray:

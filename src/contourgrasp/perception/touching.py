@@ -67,7 +67,8 @@ def split_touching(candidates, rgb, depth, intrinsics: Intrinsics, plane: Plane,
     plane : Plane
         The support surface.
     colour_offset_px : (int, int), optional
-        Where the colour lies against the depth (dx, dy), px; None: estimated on each candidate
+        The shift (dx, dy) that moves the colour onto the depth, px
+        (:func:`~contourgrasp.perception.register_colour`); None: estimated on each candidate
         (:func:`~contourgrasp.perception.colour_offset`).
     min_area_px : int
         Smallest piece, pixels.
@@ -92,14 +93,13 @@ def split_touching(candidates, rgb, depth, intrinsics: Intrinsics, plane: Plane,
     if not tried:
         return candidates
     h = heights(d, intrinsics, plane)
-    offset = colour_offset_px
-    if offset is None:
-        offset = colour_offset(image, d, np.logical_or.reduce([c.mask for c in tried]))
     found, split = [], False
     for c in candidates:
         if not any(c is t for t in tried):
             found.append(c)
             continue
+        # each its own: the colour-depth shift varies across a frame by several pixels (parallax, misregistration)
+        offset = colour_offset(image, d, c.mask) if colour_offset_px is None else colour_offset_px
         box = _grown(c.bbox, d.shape)
         rows, cols = np.mgrid[box]
         points = pixel_points_at(d[box], intrinsics, rows, cols)
