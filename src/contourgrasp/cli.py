@@ -275,7 +275,8 @@ def _add_bench_parser(sub) -> None:
     objects = bench.add_mutually_exclusive_group()
     objects.add_argument("--objects", default="can,case,bottle,stone1,stone2",
                          help="comma-separated names of the simulated objects or of object sets (thesis: the "
-                              "five; a set is reported as a split) (default: the thesis's five)")
+                              "five; ycb-train, ycb-test; procedural:N and procedural-test:N, seeded objects "
+                              "to train and to report on; a set is reported as a split) (default: the thesis's five)")
     objects.add_argument("--mesh", nargs="+", metavar="FILE", help="OBJ/STL mesh files in meters, z up, instead")
     bench.add_argument("--trials", type=_positive_int, default=20, help="trials per object and planner")
     bench.add_argument("--seed", type=_non_negative_int, default=0, help="trial t uses seed SEED + t")

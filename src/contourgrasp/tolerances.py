@@ -140,6 +140,8 @@ SUPPORT_RING_FRACTION = 0.5
 SUPPORT_RING_PX = 3
 #: A hole in an object's mask of at least this many pixels that sees the support surface is object-free.
 MIN_TABLE_HOLE_PX = 20
+#: A procedural object set (``--objects procedural:N``) holds at most this many objects.
+MAX_PROCEDURAL_OBJECTS = 1000
 #: ``plan --all`` plans at most this many objects (bounds the work a cluttered frame can ask for).
 MAX_ALL_OBJECTS = 16
 

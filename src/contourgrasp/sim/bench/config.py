@@ -16,6 +16,7 @@ from ..planners import BASELINES, make_planner, synthesis_planner
 from ..render import DEFAULT_SENSOR, SENSORS
 from ..scene import Camera, Workspace
 from ..trial import DROPPED, FAILURE_CAUSES, HIT, MISSED, NO_PLAN, PUSHED, SLIPPED, STRUCK, TrialRecord, run_trial
+from ..procedural import procedural_names
 from ..ycb import OBJECT_SETS, load_object, object_names
 
 #: Success rates of Table 4.4 (real arm and qbHand, 10 trials per object).
@@ -172,8 +173,9 @@ def resolve_objects(objects) -> tuple[tuple[ObjectSpec, ...], tuple[tuple[str, t
     """The objects of ``--objects`` and the splits it names: ``(objects, splits)`` for :class:`Bench`.
 
     Every name is checked before any object is loaded. A set name of
-    :data:`OBJECT_SETS` among ``objects`` becomes a split (its members'
-    object names); plain object names belong to none.
+    :data:`OBJECT_SETS` or a procedural set (``procedural:N``,
+    ``procedural-test:N``: :mod:`~contourgrasp.sim.procedural`) among ``objects``
+    becomes a split (its members' object names); plain object names belong to none.
 
     Raises
     ------
@@ -191,11 +193,12 @@ def resolve_objects(objects) -> tuple[tuple[ObjectSpec, ...], tuple[tuple[str, t
 
     # The first run on a machine decomposes every non-convex mesh (CoACD, up to a minute and a half each):
     # a bar on a terminal says which object it is on; once cached, loading all 41 YCB objects takes seconds.
-    specs = tuple(load_object(n) for n in tqdm(object_names(tokens), desc="loading objects", unit="object",
-                                                 leave=False, disable=None))
-    names = [o.name for o in specs]
-    splits = tuple((t, tuple(n for n in names if n in OBJECT_SETS[t])) for t in dict.fromkeys(tokens)
-                   if t in OBJECT_SETS)
+    loaded = object_names(tokens)
+    specs = tuple(load_object(n) for n in tqdm(loaded, desc="loading objects", unit="object", leave=False,
+                                                 disable=None))
+    name_of = {n: o.name for n, o in zip(loaded, specs, strict=True)}
+    splits = tuple((t, tuple(name_of[n] for n in object_names([t]))) for t in dict.fromkeys(tokens)
+                   if t in OBJECT_SETS or procedural_names(t) is not None)
     return specs, splits
 
 
