@@ -34,3 +34,14 @@ def test_components_label_and_count_as_opencv_on_the_whole_image(threads):
 def test_an_empty_mask_is_all_background():
     count, labels, areas = components(np.zeros((4, 5), dtype=bool))
     assert count == 1 and not labels.any() and areas.tolist() == [20]
+
+
+def test_fill_holes_is_scipys_binary_fill_holes():
+    from scipy import ndimage
+
+    from contourgrasp.perception._pixels import fill_holes
+
+    rng = np.random.default_rng(0)
+    for _ in range(200):
+        mask = rng.random((int(rng.integers(1, 40)), int(rng.integers(1, 40)))) < rng.uniform(0.2, 0.8)
+        np.testing.assert_array_equal(fill_holes(mask), ndimage.binary_fill_holes(mask))

@@ -34,7 +34,7 @@ from ..errors import PerceptionError, SegmentationError
 from ..tolerances import (CANDIDATE_DEPTH_STEP, CLICK_REACH_PX, CONTAINER_FLOOR_AREA, ENCLOSED_FRACTION, FLAT_HEIGHT_SIGMAS,
                           LOW_PART_REACH_PX, LOW_PART_STEP, MIN_AREA_PX, MIN_HEIGHT, SENSOR_RANGE,
                           SIMILAR_SIZE)
-from ._pixels import check_pixel, connected_to, even_box, stats_in_image
+from ._pixels import check_pixel, connected_to, even_box, fill_holes, stats_in_image
 from .camera import Intrinsics, as_depth, check_intrinsics, valid_depth
 from .region import mask_contour, touching_regions
 from .segment_depth import open_specks, raised_pixels
@@ -278,7 +278,7 @@ def _holds_floor(region, depth, focal) -> bool:
     """Whether ``region`` (bool, on its box) closes round at least ``CONTAINER_FLOOR_AREA`` m^2 at its median depth."""
     if focal is None:
         return False
-    holes = int(ndimage.binary_fill_holes(np.pad(region, 1))[1:-1, 1:-1].sum() - region.sum())
+    holes = int(fill_holes(region).sum() - region.sum())
     z = float(np.median(depth[region]))
     return holes * z * z >= CONTAINER_FLOOR_AREA * focal[0] * focal[1]
 
@@ -298,7 +298,7 @@ def _encloses(pieces, seeds, stats, origin) -> bool:
         if not within.any():
             continue
         box = np.s_[y[i]:y[i] + h[i], x[i]:x[i] + w[i]]
-        filled = ndimage.binary_fill_holes(np.pad(pieces[box] == p, 1))[1:-1, 1:-1]
+        filled = fill_holes(pieces[box] == p)
         for q in found[within]:
             other = pieces[box] == q
             if (filled & other).sum() > ENCLOSED_FRACTION * other.sum():
@@ -319,7 +319,7 @@ def _filled(region, bbox) -> np.ndarray:
     x, y, w, h = bbox
     box = np.s_[y:y + h, x:x + w]
     out = np.zeros(region.shape, dtype=bool)
-    out[box] = ndimage.binary_fill_holes(np.pad(region[box], 1))[1:-1, 1:-1]
+    out[box] = fill_holes(region[box])
     return out
 
 

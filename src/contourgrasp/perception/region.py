@@ -18,12 +18,11 @@ from dataclasses import dataclass
 
 import cv2
 import numpy as np
-from scipy import ndimage
 
 from ..contour.polygon import repair_self_intersections
 from ..errors import PerceptionWarning, SegmentationError
 from ..tolerances import CONTOUR_EPSILON_PX, MAX_OUTLINE_POINTS, SIMILAR_SIZE
-from ._pixels import components
+from ._pixels import components, fill_holes
 from .table import Plane
 
 
@@ -148,7 +147,7 @@ def _fill_holes(region):
     rows, cols = np.flatnonzero(region.any(axis=1)), np.flatnonzero(region.any(axis=0))
     box = np.s_[rows[0] - 1: rows[-1] + 2, cols[0] - 1: cols[-1] + 2]
     out = np.zeros(region.shape, dtype=bool)
-    out[box] = ndimage.binary_fill_holes(region[box])
+    out[box] = fill_holes(region[box])
     return out
 
 

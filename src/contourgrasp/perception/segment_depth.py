@@ -11,7 +11,6 @@ from dataclasses import dataclass, replace
 
 import cv2
 import numpy as np
-from scipy import ndimage
 
 from .. import validation
 from ..errors import PerceptionError
@@ -19,7 +18,7 @@ from ..tolerances import (FOOTPRINT_CELL, FOOTPRINT_CLOSE, FOOTPRINT_MAX_CELLS, 
                           MIN_AREA_PX, MIN_HEIGHT, MIN_TABLE_HOLE_PX, PLANE_THRESHOLD, SENSOR_RANGE,
                           TILT_PLANE_THRESHOLD)
 from ._frame import memoised
-from ._pixels import check_pixel, connected_to, disc, grown_box, in_image, pixel_box
+from ._pixels import check_pixel, connected_to, disc, fill_holes, grown_box, in_image, pixel_box
 from .camera import Intrinsics, as_depth, check_intrinsics, fill_depth_holes, pixel_points, valid_depth
 from .region import Segmentation, make_segmentation, pick_object
 from .table import Plane, fit_table_plane, footprint_pixels, heights, plane_axes, table_points
@@ -257,7 +256,7 @@ def open_table_holes(mask, depth, intrinsics: Intrinsics, plane: Plane, *, min_p
     if not on_plane.any():
         return mask
     standing = m & ~on_plane
-    holes = ndimage.binary_fill_holes(standing) & ~standing
+    holes = fill_holes(standing) & ~standing
     count, labels = cv2.connectedComponents(holes.astype(np.uint8), connectivity=4)
     size = np.bincount(labels.ravel(), minlength=count)
     seen = np.bincount(labels.ravel(), weights=on_plane.ravel(), minlength=count)
@@ -419,7 +418,7 @@ class _TableGrid:
         _, i, j = self.cells(self.xy)
         hit[i, j] = 1
         radius = max(1, int(round(FOOTPRINT_CLOSE / self.cell)))
-        closed = ndimage.binary_fill_holes(cv2.morphologyEx(hit, cv2.MORPH_CLOSE, disc(radius)) > 0)
+        closed = fill_holes(cv2.morphologyEx(hit, cv2.MORPH_CLOSE, disc(radius)) > 0)
         grow = int(round(0.5 * spacing / self.cell))
         return cv2.dilate(closed.astype(np.uint8), disc(grow)) > 0 if grow else closed
 
