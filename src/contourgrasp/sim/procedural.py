@@ -51,7 +51,7 @@ FAMILIES = ("box", "cylinder", "bottle", "mug", "bowl", "utensil", "tool", "smal
 _DENSITY = {"bottle": 900.0, "mug": 1300.0, "bowl": 1050.0, "utensil": 3000.0, "tool": 1200.0}
 _SOLID = {"cardboard": 300.0, "wood": 600.0, "tinplate": 800.0, "hard-plastic": 1050.0, "steel": 7800.0,
           "glass": 2500.0, "rubber": 500.0, "plastic-fruit": 300.0, "stone": 2700.0}
-_NAME = re.compile(r"proc-(\d+)(?:-[a-z]+)?$")
+_NAME = re.compile(r"proc-(\d+)(?:-([a-z]+))?$")
 _SET = re.compile(r"(procedural|procedural-test):(\d+)$")
 
 
@@ -95,6 +95,13 @@ def procedural_names(token: str) -> tuple[str, ...] | None:
         raise SimulationError(f"{token}: a procedural set holds 1 to {MAX_PROCEDURAL_OBJECTS} objects, got {count}")
     first = 0 if found.group(1) == "procedural" else TEST_SEED
     return tuple(f"proc-{s}" for s in range(first, first + count))
+
+
+def procedural_family(name: str) -> str | None:
+    """The family of a name ``proc-<seed>-<family>`` (:data:`FAMILIES`); None for any other name."""
+    found = _NAME.match(name)
+    family = None if found is None else found.group(2)
+    return family if family in FAMILIES else None
 
 
 def procedural_seed(name: str) -> int | None:

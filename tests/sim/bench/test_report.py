@@ -152,3 +152,23 @@ def test_the_reports_first_paragraph_says_how_the_hand_is_simulated():
     assert "depth sensor `structured-light`, a robot arm in view (seen, never touched);" in robot
     with pytest.raises(SimulationError, match="robot must be True or False"):
         Bench(objects=thesis_objects(["can"]), robot="yes")
+
+
+def test_procedural_objects_are_reported_per_family_too(tmp_path):
+    from contourgrasp.sim.procedural import procedural_object
+
+    objects = tuple(procedural_object(s) for s in (1, 6, 9))  # two bowls and a mug
+    assert [o.name for o in objects] == ["proc-1-bowl", "proc-6-bowl", "proc-9-mug"]
+    bench = Bench(objects=objects, planners=("default",), trials=2,
+                  splits=(("procedural:10", tuple(o.name for o in objects)),))
+    rates = {"default": {"proc-1-bowl": 2, "proc-6-bowl": 1, "proc-9-mug": 0}}
+    write_outputs(bench, _split_results(bench, rates), tmp_path, wall_time=1.0)
+    table = (tmp_path / "table.md").read_text()
+    assert "## Per family (procedural objects)" in table
+    assert "| mug | 1 | 0 % (0–66) 0/2 | pushed 2 |" in table
+    assert "| bowl | 2 | 75 % (30–95) 3/4 | pushed 1 |" in table
+    assert table.index("| mug |") < table.index("| bowl |")  # the families' order: FAMILIES
+
+
+def test_a_bench_without_procedural_objects_has_no_family_table(bench_out):
+    assert "Per family" not in (bench_out / "table.md").read_text()

@@ -29,6 +29,7 @@ from pathlib import Path
 
 from ...io.plan_file import atomic_outputs, write_json
 from ..planners import BASELINES, ablation_planners, synthesis_planner
+from ..procedural import FAMILIES, procedural_family
 from ..trial import TrialRecord
 from .config import SHORT_CAUSES, Bench, BenchTrial, label
 from .run import picked_trials, snapshot
@@ -301,6 +302,12 @@ def split_markdown(bench: Bench, results, *, wall_time: float, kept: int = 0) ->
         "",
         *object_table(bench, results),
     ]
+    families = family_table(bench, results)
+    if families:
+        lines += ["", "## Per family (procedural objects)", "",
+                  "Each cell: success rate, its 95 % Wilson interval, and successes / trials, every split's "
+                  f"objects of the family together; last, `{sort_planner(bench)}`'s failures by cause.", "",
+                  *families]
     ablation = ablation_table(bench, results)
     if len(ablation) > 3:  # more than one step ran
         lines += ["", "## Ablation: paper to default", "", *ablation]
@@ -361,4 +368,27 @@ def object_table(bench: Bench, results) -> list[str]:
         failures = ", ".join(f"{SHORT_CAUSES[c]} {causes.count(c)}" for c in bench.causes if c in causes)
         cells = [_rate_cell(records(results, p, name)) for p in bench.planners]
         lines.append(_row([label(name), bench.split_of(name) or "—", *cells, failures or "—"]))
+    return lines
+
+
+def family_table(bench: Bench, results) -> list[str]:
+    """A row per procedural family present (:data:`~contourgrasp.sim.procedural.FAMILIES`' order): every planner's rate
+    on its objects, and :func:`sort_planner`'s failures by cause; empty without procedural objects."""
+    members = {}
+    for o in bench.objects:
+        family = procedural_family(o.name)
+        if family is not None:
+            members.setdefault(family, []).append(o.name)
+    if not members:
+        return []
+    planner = sort_planner(bench)
+    lines = _header("family", ["objects", *bench.planners, f"{planner}'s failures"], left=1)
+    for family in (f for f in FAMILIES if f in members):
+        cells = []
+        for p in bench.planners:
+            own = _of(results, p, members[family])
+            cells.append(f"{_rate_cell(own)} {sum(r.success for r in own)}/{len(own)}")
+        causes = [r.cause for r in _of(results, planner, members[family]) if r.cause is not None]
+        failures = ", ".join(f"{SHORT_CAUSES[c]} {causes.count(c)}" for c in bench.causes if c in causes)
+        lines.append(_row([family, len(members[family]), *cells, failures or "—"]))
     return lines
