@@ -87,6 +87,17 @@ def test_arc_follows_eq_3_20():
     assert angle > 0
 
 
+def test_a_negative_a_sin_is_the_mirrored_arc_turning_clockwise():
+    counter, clockwise = Arc(0.055, 0.04, 3.77), Arc(0.055, -0.04, 3.77)
+    lam = np.linspace(0.0, 0.09, 10)
+    np.testing.assert_allclose(clockwise.offset(lam), counter.offset(lam) * [1.0, -1.0], atol=1e-12)
+    assert clockwise.perimeter == pytest.approx(counter.perimeter)
+    steps = np.diff(clockwise.offset(lam), axis=0)
+    assert (steps[:-1, 0] * steps[1:, 1] - steps[:-1, 1] * steps[1:, 0] < 0).all()  # turning clockwise
+    with pytest.raises(HandError, match=r"arc \|a_sin\|"):
+        Arc(0.055, 0.0, 3.77)
+
+
 def test_curved_thumb_ends_opposite_the_fingers():
     hand = load_hand("five-finger-curved-thumb")
     thumb, index = hand.fingers[0].end, hand.fingers[1].end

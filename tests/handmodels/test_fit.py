@@ -22,6 +22,17 @@ def test_fit_finger_recovers_an_arc_and_refuses_a_zigzag():
         fit_finger("zig", zigzag)
 
 
+def test_fit_finger_recovers_a_clockwise_arc_as_the_mirrored_ellipse():
+    # a right hand's curling finger, projected, turns clockwise: the mirror image of a counter-clockwise arc
+    counter = Arc(0.05, 0.03, 3.5)
+    lam = np.linspace(0.0, 0.06, 300)
+    path = np.array([0.1, 0.2]) + counter.offset(lam) * [1.0, -1.0]
+    finger, fit = fit_finger("curl", path)
+    assert fit.kind == "arc" and fit.error < 1e-6
+    assert finger.trajectory.a_sin == pytest.approx(-0.03, abs=1e-6)
+    np.testing.assert_allclose(finger.points(lam[::30]), path[::30], atol=1e-6)
+
+
 def box_corners(centre, half, turn=0.0):
     """(8, 3) float: a box's corners in fit.BOX_CORNERS's order, turned by ``turn`` about the y axis."""
     c, s = np.cos(turn), np.sin(turn)

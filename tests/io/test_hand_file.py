@@ -149,11 +149,23 @@ def test_absurd_magnitudes_are_refused_naming_the_field(tmp_path, line, field):
                                              ('closing_direction = [1.0, 0.0]',
                                               "arc = { a_cos = 0.05, a_sin = 0.04, phi_off = 1e300 }", "phi_off"),
                                              ('closing_direction = [1.0, 0.0]',
-                                              "arc = { a_cos = 1e300, a_sin = 0.04, phi_off = 0.0 }", "a_cos")])
+                                              "arc = { a_cos = 1e300, a_sin = 0.04, phi_off = 0.0 }", "a_cos"),
+                                             ('closing_direction = [1.0, 0.0]',
+                                              "arc = { a_cos = 0.05, a_sin = 0.0, phi_off = 0.0 }", "a_sin"),
+                                             ('closing_direction = [1.0, 0.0]',
+                                              "arc = { a_cos = 0.05, a_sin = -1e300, phi_off = 0.0 }", "a_sin")])
 def test_absurd_lengths_and_angles_are_refused_naming_the_field(old, new, field):
     """A start of 1e300 or an arc phi_off of 1e300 once divided by zero in the search's kernels."""
     with pytest.raises(HandFileError, match=f"fingers\\[0\\] \\(left\\).*{field}"):
         parse_hand(ONE_FINGER.replace(old, new), source="hand.toml")
+
+
+def test_a_clockwise_arc_finger_round_trips():
+    hand = parse_hand(ONE_FINGER.replace("closing_direction = [1.0, 0.0]",
+                                         "arc = { a_cos = 0.05, a_sin = -0.04, phi_off = 1.0 }"))
+    assert hand.fingers[0].trajectory.a_sin == -0.04
+    again = parse_hand(hand_to_toml(hand))
+    np.testing.assert_array_equal(again.fingers[0].points(np.linspace(0, 0.1, 5)), hand.fingers[0].points(np.linspace(0, 0.1, 5)))
 
 
 @pytest.mark.parametrize("content", [bytes(range(256)), "name = 'h'".encode("utf-16"), b"\xff\xfe\x00"])

@@ -74,13 +74,16 @@ class Arc:
     """Elliptic-arc closing motion: radii ``a_cos``, ``a_sin`` (m), start angle ``phi_off`` (rad).
 
     Implements eq 3.20 and 3.21: the fingertip moves by ``E(phi_off + theta) - E(phi_off)``
-    (:meth:`offset`), the ellipse point less its offset at the start.
+    (:meth:`offset`), the ellipse point less its offset at the start. The thesis's arcs turn
+    counter-clockwise (theta grows); a negative ``a_sin`` mirrors the ellipse about the hand
+    frame's x axis, so the arc turns clockwise: the mirror image of a counter-clockwise finger, as
+    a right hand's fingers are of a left hand's (``hand-from-model`` fits either).
 
     Raises
     ------
     HandError
-        A radius that is not positive or above ``tolerances.MAX_HAND_SIZE``, or ``|phi_off|``
-        above ``tolerances.MAX_ARC_ANGLE``.
+        ``a_cos`` not positive, ``a_sin`` zero, either's magnitude above ``tolerances.MAX_HAND_SIZE``,
+        or ``|phi_off|`` above ``tolerances.MAX_ARC_ANGLE``.
     """
 
     a_cos: float
@@ -88,8 +91,9 @@ class Arc:
     phi_off: float
 
     def __post_init__(self):
-        for name in ("a_cos", "a_sin"):
-            check.bounded(f"arc {name}", getattr(self, name), tol.MAX_HAND_SIZE, " m", strict=True, error=HandError)
+        check.bounded("arc a_cos", self.a_cos, tol.MAX_HAND_SIZE, " m", strict=True, error=HandError)
+        a_sin = check.finite("arc a_sin", self.a_sin, error=HandError)
+        check.bounded("arc |a_sin|", abs(a_sin), tol.MAX_HAND_SIZE, " m", strict=True, error=HandError)
         angle = check.finite("arc phi_off", self.phi_off, error=HandError)
         check.at_most("arc |phi_off|", abs(angle), tol.MAX_ARC_ANGLE, " rad", error=HandError)
 

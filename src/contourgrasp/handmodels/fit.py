@@ -82,7 +82,7 @@ def fit_finger(name: str, path, *, radius: float = 0.0) -> tuple[Finger, FingerF
     arc, arc_error = _fit_arc(name, path, radius)
     if arc is not None and arc_error <= tol.MODEL_FIT_TOLERANCE:
         return arc, FingerFit(name, "arc", arc_error, ray_error)
-    arc_text = f"arc {1000 * arc_error:.2f} mm" if arc is not None else "no arc (the path turns clockwise or is no ellipse)"
+    arc_text = f"arc {1000 * arc_error:.2f} mm" if arc is not None else "no arc (the path is no ellipse)"
     raise HandError(f"finger {name!r}: no ray or arc fits its tip path on the palm plane within "
                     f"{1000 * tol.MODEL_FIT_TOLERANCE:g} mm (ray {1000 * ray_error:.2f} mm, {arc_text})")
 
@@ -103,7 +103,9 @@ def _fit_arc(name: str, path: np.ndarray, radius: float) -> tuple[Finger | None,
     a_cos, a_sin = scale * np.sqrt(level / a), scale * np.sqrt(level / b)
     centre = mean + scale * np.array([cx, cy])
     angles = np.unwrap(np.arctan2((path[:, 1] - centre[1]) / a_sin, (path[:, 0] - centre[0]) / a_cos))
-    if angles[-1] <= angles[0] or max(a_cos, a_sin) > tol.MAX_HAND_SIZE:
+    if angles[-1] < angles[0]:  # a clockwise path: the mirrored ellipse, on which it turns counter-clockwise
+        a_sin, angles = -a_sin, -angles
+    if angles[-1] <= angles[0] or max(a_cos, abs(a_sin)) > tol.MAX_HAND_SIZE:
         return None, np.inf
     try:
         arc = Arc(float(a_cos), float(a_sin), float(angles[0]))

@@ -28,6 +28,7 @@ Schema (all lengths in meters, angles in radians)::
     start = [-0.115, 0.1]            # (x_f, y_f), hand frame
     closing_direction = [0.994, 0.106]   # a ray ...
     # arc = { a_cos = 0.055, a_sin = 0.04, phi_off = 3.77 }   # ... or an elliptic arc
+                                     # (counter-clockwise; a negative a_sin: clockwise)
     travel = 0.09                    # F > 0: distance (arc length for arcs)
     virtual_start = 0.03             # lambda_virt, optional, default 0
     alpha = 25.0                     # curvature gain, optional, default 1
@@ -99,8 +100,15 @@ class _Strict(BaseModel):
 
 class _ArcSchema(_Strict):
     a_cos: Length
-    a_sin: Length
+    a_sin: Offset
     phi_off: Angle
+
+    @field_validator("a_sin")
+    @classmethod
+    def _not_zero(cls, value: float) -> float:
+        if value == 0:
+            raise ValueError("must not be 0 (negative: an arc turning clockwise)")
+        return value
 
 
 Angles2 = Annotated[list[Annotated[float, Field(ge=-tol.MAX_JOINT_ANGLE, le=tol.MAX_JOINT_ANGLE,
