@@ -195,7 +195,8 @@ def test_plan_frame_plans_on_the_chosen_target_and_lists_the_candidates():
     assert [o["in_view"] for o in data["objects"]] == [False, True, True]
     assert data["objects"][2] == {"label": 3, "area_px": 1600, "height": pytest.approx(0.08, abs=1e-6),
                                   "extent": pytest.approx([39 * 0.62 / 525] * 2, rel=1e-6),
-                                  "centroid_px": [499.5, 319.5], "in_view": True, "bbox": [480, 300, 40, 40]}
+                                  "centroid_px": [499.5, 319.5], "in_view": True, "touching": False,
+                                  "bbox": [480, 300, 40, 40]}
     assert data["target"] == {"label": 3, "reason": "the candidate under pixel (490, 310)"}
     by_roi = cg.plan_grasp(None, depth, CAMERA, hand, roi=(470, 290, 20, 20), **FAST)
     np.testing.assert_allclose(by_roi.T_camera_hand, chosen.T_camera_hand)

@@ -10,6 +10,7 @@ import pytest
 import contourgrasp as cg
 from contourgrasp.errors import PerceptionError
 from contourgrasp.io.camera_file import read_rgbd
+from contourgrasp.io.plan_file import image_plan_to_dict
 from contourgrasp.perception import find_candidates, fit_table_plane, split_touching
 from contourgrasp.pipeline import find_objects
 
@@ -93,6 +94,7 @@ def test_plan_frame_plans_on_one_of_the_touching_objects():
     rgb, depth = frame(LOW, TALL)
     result = cg.plan_grasp(rgb, depth, CAMERA, cg.load_hand("five-finger-linear"), target_px=(250, 240), yaw_step=0.1)
     assert iou(result.segmentation.mask, box_mask(LOW)) > 0.95
+    assert [o["touching"] for o in image_plan_to_dict(result)["objects"]] == [True, True]  # the plan file says so
 
 
 def test_bad_input_is_refused_by_name():

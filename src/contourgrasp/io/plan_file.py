@@ -127,7 +127,8 @@ def height_map_summary(heights) -> dict | None:
 def candidate_to_dict(candidate) -> dict:
     """The plan file's entry of a :class:`~contourgrasp.perception.Candidate` (not its mask or outline).
 
-    ``{label, area_px, height (m), extent: [length, width] (m), centroid_px: [u, v], in_view, bbox: [x, y, w, h]}``.
+    ``{label, area_px, height (m), extent: [length, width] (m), centroid_px: [u, v], in_view, touching,
+    bbox: [x, y, w, h]}``.
     """
     return {
         "label": candidate.label,
@@ -136,6 +137,7 @@ def candidate_to_dict(candidate) -> dict:
         "extent": [float(v) for v in candidate.extent],
         "centroid_px": [float(v) for v in candidate.centroid_px],
         "in_view": bool(candidate.in_view),
+        "touching": bool(candidate.touching),
         "bbox": [int(v) for v in candidate.bbox],
     }
 

@@ -129,9 +129,9 @@ def _in_image(piece, box, shape) -> np.ndarray:
 
 
 def _lab(image, offset, box) -> np.ndarray:
-    """(h, w, 3) float32: CIELAB (OpenCV's 8-bit scale), 5 x 5 median-filtered, of the colour that lies ``offset``
-    (dx, dy) px from the depth image (:func:`~contourgrasp.perception.register_colour`) on its ``box``; the edge
-    repeats beyond the image."""
+    """(h, w, 3) float32: CIELAB (OpenCV's 8-bit scale), 5 x 5 median-filtered, of the colour image shifted by
+    ``offset`` (dx, dy) px onto the depth image (:func:`~contourgrasp.perception.register_colour`), on the depth's
+    ``box``; the edge repeats beyond the image."""
     rows = np.clip(np.arange(box[0].start, box[0].stop) - offset[1], 0, image.shape[0] - 1)
     cols = np.clip(np.arange(box[1].start, box[1].stop) - offset[0], 0, image.shape[1] - 1)
     colour = np.ascontiguousarray(image[np.ix_(rows, cols)])
