@@ -36,10 +36,11 @@ from __future__ import annotations
 import re
 
 import numpy as np
+from scipy.spatial import ConvexHull
 
 from ..errors import SimulationError
 from ..tolerances import MAX_PROCEDURAL_OBJECTS
-from .objects import ObjectSpec, Part, _axis_to_x, _frustum, _pebble
+from .objects import ObjectSpec, Part, _axis_to_x, _frustum, _pebble, _quat_matrix
 from .materials import MATERIALS
 
 #: The first seed of the held-out set ``procedural-test:N``.
@@ -229,8 +230,6 @@ def _moved(part: Part, shift) -> Part:
 
 def _turned(part: Part, quat) -> Part:
     """``part`` turned by the rotation ``quat`` (w, x, y, z) about the object frame's origin."""
-    from .objects import _quat_matrix
-
     turn = _quat_matrix(quat)
     pos = tuple(turn @ np.asarray(part.pos))
     if part.kind == "mesh":
@@ -251,8 +250,7 @@ def _quat_product(a, b) -> tuple[float, float, float, float]:
 
 
 def _volume(part: Part) -> float:
-    from scipy.spatial import ConvexHull
-
+    """The volume of ``part``'s convex hull, m^3 (every part is convex)."""
     return float(ConvexHull(part.surface_points()).volume)
 
 
