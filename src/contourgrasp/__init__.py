@@ -103,7 +103,7 @@ def synthesize(contour_xy, hand, *, planner=None, **options):
 #: :func:`contourgrasp.synthesis.search`'s own keywords, which :func:`synthesize` passes on.
 _SEARCH_CALL = ("descent", "low_object", "balance_required", "balanced_alternative")
 #: :func:`contourgrasp.pipeline.plan_frame`'s own keywords, which :func:`plan_grasp` passes on.
-_FRAME_CALL = ("mask", "target_px", "roi", "T_base_camera", "colour_intrinsics")
+_FRAME_CALL = ("mask", "target_px", "roi", "T_base_camera", "colour_intrinsics", "memory")
 
 
 def plan_grasp(rgb, depth, intrinsics, hand="five-finger-linear", *, planner=None, **options):
@@ -112,7 +112,7 @@ def plan_grasp(rgb, depth, intrinsics, hand="five-finger-linear", *, planner=Non
     ``options`` are :class:`~contourgrasp.pipeline.PlanOptions` by name (``segment``, ``depth_mode``,
     ``xy_step``, ``descent``, ``standoff``, ...), which override the planner's, and
     :func:`~contourgrasp.pipeline.plan_frame`'s own keywords (``mask``, ``target_px``, ``roi``,
-    ``T_base_camera``, ``colour_intrinsics``). Returns an :class:`contourgrasp.pipeline.ImageGraspPlan` (``.plan`` is the
+    ``T_base_camera``, ``colour_intrinsics``, ``memory``). Returns an :class:`contourgrasp.pipeline.ImageGraspPlan` (``.plan`` is the
     :class:`GraspPlan`, ``.T_camera_hand`` the 6-DoF pose).
     """
     from . import validation

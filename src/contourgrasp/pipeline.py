@@ -34,7 +34,7 @@ from .hand import Hand
 from .perception import HeightMap, Intrinsics, MetricContour, Plane, Segmentation
 from .perception.camera import check_intrinsics
 from .perception.options import PerceptionOptions
-from .synthesis import Descent, GraspPlan, search
+from .synthesis import Descent, GraspMemory, GraspPlan, search
 from .synthesis.grasp_height import grasp_height as choose_grasp_height
 from .synthesis.options import SceneOptions, SearchOptions
 from .tolerances import HOMOGENEOUS_ROW, MAX_STANDOFF, ROTATION_TOLERANCE
@@ -153,6 +153,7 @@ def plan_frame(
     roi=None,
     T_base_camera=None,
     colour_intrinsics: Intrinsics | None = None,
+    memory: GraspMemory | None = None,
 ) -> ImageGraspPlan:
     """Plan a grasp on one RGB-D frame with a :class:`~contourgrasp.hand.Hand`.
 
@@ -189,6 +190,10 @@ def plan_frame(
     colour_intrinsics : Intrinsics, optional
         The colour camera's, when ``rgb`` has another resolution than ``depth`` and not the same view
         scaled.
+    memory : GraspMemory, optional
+        The grasps of this object that failed (:class:`~contourgrasp.synthesis.memory.GraspMemory`): no
+        pose near one, in the object's frame as it is seen now, is planned. After a failure, keep
+        ``memory.with_failure(result.metric.contour_xy, result.plan.pose)`` for the next plan.
 
     Notes
     -----
@@ -219,6 +224,8 @@ def plan_frame(
         raise HandError(f"hand must be a contourgrasp.Hand, got {type(hand).__name__}")
     if not isinstance(options, PlanOptions):
         raise PlannerError(f"options must be a contourgrasp.pipeline.PlanOptions, got {type(options).__name__}")
+    if memory is not None and not isinstance(memory, GraspMemory):
+        raise PlannerError(f"memory must be a contourgrasp.synthesis.GraspMemory, got {type(memory).__name__}")
     if T_base_camera is not None:
         T_base_camera = validation.rigid_transform("T_base_camera", T_base_camera, error=PerceptionError,
                                                    rotation_tolerance=ROTATION_TOLERANCE,
@@ -235,11 +242,12 @@ def plan_frame(
     low = scene_options.low_objects and heights is not None and bool(heights.max_height < tol.LOW_OBJECT_HEIGHT)
     slicing = hand.slice_contour if scene_options.slice_contour == "hand" else scene_options.slice_contour
     section = perception.cross_section(heights, asked[0]) if slicing is True and asked is not None else None
+    exclude = None if not memory else partial(memory.excluded, metric.contour_xy)
     on_section = None
     if slicing == "unbalanced" and asked is not None:
-        on_section = partial(_balanced_on_section, heights, hand, spec, asked[0], search_options, low)
+        on_section = partial(_balanced_on_section, heights, hand, spec, asked[0], search_options, low, exclude)
     plan = search(metric.contour_xy if section is None else section, hand, search_options, descent=spec,
-                  balanced_alternative=on_section, low_object=low)
+                  balanced_alternative=on_section, low_object=low, exclude=exclude)
     tip_height = None if asked is None else asked[0] if plan.descent is None else float(plan.descent.tip_height[0])
     depth_at = (metric.approach_depth if tip_height is None
                 else palm_depth(metric, heights, hand, plan.pose, tip_height))
@@ -257,13 +265,14 @@ NOTE_SECTION = ("no pose balances the squeeze on the outline seen: planned on th
 
 
 def _balanced_on_section(heights: HeightMap, hand: Hand, descent, height: float, options: SearchOptions,
-                         low_object: bool) -> GraspPlan:
+                         low_object: bool, exclude=None) -> GraspPlan:
     """The plan on the object's cross-section at ``height`` with a balanced squeeze (the search requires
     it): the outline seen's ``balanced_alternative``. Raises NoFeasibleGrasp without one, or without a section."""
     section = perception.cross_section(heights, height)
     if section is None:
         raise NoFeasibleGrasp("the height map has no cross-section of the object")
-    sliced = search(section, hand, options, descent=descent, balance_required=True, low_object=low_object)
+    sliced = search(section, hand, options, descent=descent, balance_required=True, low_object=low_object,
+                    exclude=exclude)
     return replace(sliced, search_notes=sliced.search_notes + (NOTE_SECTION.format(height=1000 * height),))
 
 

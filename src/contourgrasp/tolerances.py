@@ -219,6 +219,17 @@ MIN_FLAT_HEIGHT = 0.0005
 #: mask; the whole image is searched only when the evidence reaches that window's edge.
 FLAT_WINDOW_PX = 96
 
+#: A memory of failed grasps (synthesis.memory) excludes the poses within this distance (m) of a failure mapped into
+#: the object's frame: a search grid step and a half (1 cm steps), so that the next plan is not the failure again ...
+MEMORY_REACH = 0.015
+#: ... and within this turn of its yaw (rad): five of the default grid's 4 deg steps.
+MEMORY_TURN = _radians(20.0)
+#: An outline whose two principal second moments differ by less than this share of the larger has no axis that turns
+#: with it (a can seen from above: its frame keeps the planning frame's orientation).
+MEMORY_ROUND = 0.1
+#: A memory keeps at most this many failures, the oldest dropped first (bounds the work a memory can ask for).
+MAX_MEMORY_FAILURES = 32
+
 #: The distance over which ``Safeguards.centring_gain`` costs its gain once, m (``synthesis.cost.centring_distance``).
 CENTRING_SCALE = 0.01
 

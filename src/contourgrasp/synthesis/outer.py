@@ -57,6 +57,7 @@ def search(
     balanced_alternative: Callable[[], GraspPlan] | None = None,
     low_object: bool = False,
     descent: Descent | None = None,
+    exclude: Callable[[np.ndarray], np.ndarray] | None = None,
 ) -> GraspPlan:
     """Plan a grasp on a contour: fit the EFD model, search the pose grid, return the best pose.
 
@@ -103,6 +104,10 @@ def search(
         (:mod:`~contourgrasp.synthesis.descent`; the hand must be 3-D). Checked exactly on the
         candidates in increasing cost, after their inner problem, until one passes. Without it:
         the thesis's 2-D problem.
+    exclude : callable, optional
+        Poses (n, 3) -> (n,) bool: the poses not to plan, such as those near grasps that failed
+        (:meth:`~contourgrasp.synthesis.memory.GraspMemory.excluded`); they are infeasible, on the grid
+        and after refinement.
 
     Notes
     -----
@@ -156,8 +161,10 @@ def search(
     if balanced_alternative is not None and not callable(balanced_alternative):
         raise PlannerError(f"balanced_alternative must be callable, got {type(balanced_alternative).__name__}")
     elsewhere = _Elsewhere(balanced_alternative)
+    if exclude is not None and not callable(exclude):
+        raise PlannerError(f"exclude must be callable, got {type(exclude).__name__}")
     outline = partial(_search_outline, hand=hand, options=replace(options, safeguards=safeguards), descent=descent,
-                      clock=clock, fallback=preferred, alternative=elsewhere)
+                      clock=clock, fallback=preferred, alternative=elsewhere, exclude=exclude)
     try:
         return _search_rules(contour, hand, options, outline, elsewhere, low_object)
     except NoFeasibleGrasp as err:
@@ -217,11 +224,11 @@ def _fewest_touching(hand: Hand) -> int:
 
 
 def _search_outline(contour, *, hand: Hand, options: SearchOptions, descent: Descent | None, clock: float,
-                    fallback: bool = True, alternative: _Elsewhere) -> GraspPlan:
-    """:func:`search` on one cleaned outline: fit, screen, then each attempt of the small-object rule and the
-    squeeze's balance in turn, then the ``alternative``'s plan, then (``fallback``) without the balance.
-    Raises :class:`_OutOfReach` when, with the fewest touching fingers tried, no pose brings them onto the
-    object within their travel."""
+                    fallback: bool = True, alternative: _Elsewhere, exclude=None) -> GraspPlan:
+    """:func:`search` on one cleaned outline: fit, screen (less the poses ``exclude`` names), then each attempt of
+    the small-object rule and the squeeze's balance in turn, then the ``alternative``'s plan, then (``fallback``)
+    without the balance. Raises :class:`_OutOfReach` when, with the fewest touching fingers tried, no pose brings
+    them onto the object within their travel."""
     harmonics, grid, safeguards = options.harmonics, options.grid, options.safeguards
     if harmonics == "adaptive":
         harmonics = choose_harmonics(contour, validate=False)
@@ -232,6 +239,7 @@ def _search_outline(contour, *, hand: Hand, options: SearchOptions, descent: Des
     screen, touch_counts, any_outside = screen_reaching(model, replace(hand, min_touching=fewest), grid,
                                                         curvature=options.curvature,
                                                         centring_gain=safeguards.centring_gain)
+    screen = _without(screen, exclude)
     share = np.full(len(screen.poses), np.nan)  # the squeeze's balance per screened pose, filled as attempts need it
     searched = time.perf_counter()
     errors = []
@@ -244,7 +252,8 @@ def _search_outline(contour, *, hand: Hand, options: SearchOptions, descent: Des
                 return _search_fitted(model, contour, replace(hand, min_touching=touching),
                                       _needing(screen, touch_counts, touching), grid, guards, descent,
                                       curvature=options.curvature, top_k=options.top_k, refine=options.refine,
-                                      times=(clock, fitted, searched), share=share, any_outside=any_outside)
+                                      times=(clock, fitted, searched), share=share, any_outside=any_outside,
+                                      exclude=exclude)
             except NoFeasibleGrasp as err:  # kept without its traceback: through this frame that would make a
                 errors.append(err.with_traceback(None))  # cycle holding every screen until the gc runs
         return None
@@ -323,6 +332,23 @@ def _no_grasp(errors: list[NoFeasibleGrasp], counts: int, fewest: int) -> str:
     return "; ".join([message] + [f"{attempt}: {reason}" for attempt, reason in later if reason != errors[0]])
 
 
+#: Why a search found nothing when the poses it was asked to leave out were all it had.
+EXCLUDED = "every pose that would satisfy the constraints lies near a grasp that failed (the memory's exclusion)"
+
+
+def _without(poses: PoseEvaluation, exclude, *, only: bool = True) -> PoseEvaluation:
+    """``poses`` with those ``exclude`` names infeasible (and not reaching); unchanged without ``exclude``.
+
+    Raises NoFeasibleGrasp (:data:`EXCLUDED`) when that leaves none of the feasible ones and they are the
+    ``only`` poses searched (the grid's screen; not a refinement's, added to it)."""
+    if exclude is None or not len(poses.poses):
+        return poses
+    keep = ~np.asarray(exclude(poses.poses), dtype=bool)
+    if only and poses.feasible.any() and not (poses.feasible & keep).any():
+        raise NoFeasibleGrasp(EXCLUDED)
+    return replace(poses, reaches=poses.reaches & keep, feasible=poses.feasible & keep)
+
+
 def _needing(screen: PoseEvaluation, counts: np.ndarray, touching: int) -> PoseEvaluation:
     """The screen of the fewest touching fingers, feasible only where at least ``touching`` fingers touch.
 
@@ -335,7 +361,7 @@ def _needing(screen: PoseEvaluation, counts: np.ndarray, touching: int) -> PoseE
 
 def _search_fitted(model: EFD, contour, hand: Hand, screen: PoseEvaluation, grid: SearchGrid,
                    safeguards: Safeguards, descent: Descent | None, *, curvature, top_k, refine,
-                   times, share, any_outside: bool) -> GraspPlan:
+                   times, share, any_outside: bool, exclude=None) -> GraspPlan:
     """:func:`search` for one ``hand.min_touching`` on a fitted model and its screened grid.
 
     ``screen``: :func:`~contourgrasp.synthesis.grid.screen_reaching`'s poses (with ``any_outside``, its
@@ -357,6 +383,7 @@ def _search_fitted(model: EFD, contour, hand: Hand, screen: PoseEvaluation, grid
         refined = refine_poses(model, hand, result.poses[ranked[:tol.REFINE_STARTS]],
                                step=(grid.xy_step, grid.yaw_step), d_max=grid.d_max,
                                curvature=curvature, d_min=grid.d_min, safeguards=safeguards)
+        refined = _without(refined, exclude, only=False)
         if descent is not None:
             passed, _, _ = check_candidates(hand, descent, refined.poses, _by_cost(refined), refined.lam,
                                             refined.touching)

@@ -1,0 +1,100 @@
+"""A memory of failed grasps: the next plan of the same object avoids them, in the object's frame.
+
+A grasp that failed is kept as its hand pose (x, y, yaw) in the object's frame (:func:`object_frame`):
+the outline's centroid, and its principal axis -- the outline's second moments of area. The object
+may have moved or turned since (a grasp that pushed it); a later plan maps every failure into the
+object's frame as it is then seen, and excludes the poses within ``tolerances.MEMORY_REACH`` (m) and
+``tolerances.MEMORY_TURN`` (rad) of one. An axis has no sign, so a failure is mapped both ways round
+it; an outline whose axes differ by less than ``tolerances.MEMORY_ROUND`` (a can seen from above, a
+ball) has no axis that turns with it, and its frame keeps the planning frame's orientation.
+
+:func:`contourgrasp.pipeline.plan_frame` takes a :class:`GraspMemory` (``memory=``), which
+:func:`~contourgrasp.synthesis.search` applies to its screened poses (``exclude=``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+from .. import validation
+from ..errors import PlannerError
+from ..tolerances import MAX_MEMORY_FAILURES, MEMORY_REACH, MEMORY_ROUND, MEMORY_TURN
+
+
+@dataclass(frozen=True)
+class GraspMemory:
+    """The failed grasps of one object, each a pose (x, y, yaw) in the object's frame (module docstring).
+
+    Immutable: :meth:`with_failure` returns a new memory. At most ``tolerances.MAX_MEMORY_FAILURES``
+    are kept, the oldest dropped first.
+
+    Examples
+    --------
+    >>> square = np.array([[0.0, 0.0], [0.04, 0.0], [0.04, 0.02], [0.0, 0.02]])
+    >>> memory = GraspMemory().with_failure(square, (0.02, 0.05, 0.0))
+    >>> moved = square + [0.1, 0.0]  # the object pushed 10 cm along x
+    >>> memory.excluded(moved, [[0.12, 0.05, 0.0], [0.02, 0.05, 0.0]]).tolist()
+    [True, False]
+    """
+
+    failures: tuple[tuple[float, float, float], ...] = ()
+
+    def __len__(self) -> int:
+        return len(self.failures)
+
+    def with_failure(self, contour_xy, pose) -> GraspMemory:
+        """This memory and the failed grasp ``pose`` (x, y, yaw) planned on the outline ``contour_xy`` ((n, 2) m)."""
+        x, y, yaw = validation.finite_array("pose", pose, (3,), error=PlannerError)
+        centre, angle = object_frame(contour_xy)
+        local = _rotation(-angle) @ (np.array([x, y]) - centre)
+        kept = (*self.failures, (float(local[0]), float(local[1]), float(_wrapped(yaw - angle))))
+        return GraspMemory(kept[-MAX_MEMORY_FAILURES:])
+
+    def excluded(self, contour_xy, poses) -> np.ndarray:
+        """(n,) bool: the poses (n, 3) near a failure, the failures mapped onto the outline ``contour_xy`` ((m, 2) m)."""
+        poses = validation.finite_array("poses", poses, (None, 3), error=PlannerError)
+        out = np.zeros(len(poses), dtype=bool)
+        if not self.failures:
+            return out
+        centre, angle = object_frame(contour_xy)
+        for turn in (angle, angle + np.pi):  # the axis has no sign
+            local = np.asarray(self.failures)
+            xy = local[:, :2] @ _rotation(turn).T + centre
+            yaw = local[:, 2] + turn
+            near = np.linalg.norm(poses[:, None, :2] - xy[None], axis=-1) <= MEMORY_REACH
+            near &= np.abs(_wrapped(poses[:, None, 2] - yaw[None])) <= MEMORY_TURN
+            out |= near.any(axis=1)
+        return out
+
+
+def object_frame(contour_xy) -> tuple[np.ndarray, float]:
+    """The object's frame in the planning plane: its outline's centroid ((2,) m) and principal axis's angle (rad).
+
+    The axis is that of the outline's largest second moment of area; 0 for an outline whose two
+    moments differ by less than ``tolerances.MEMORY_ROUND`` of the larger (round: no axis turns with it).
+    """
+    contour = validation.finite_array("contour_xy", contour_xy, (None, 2), error=PlannerError)
+    if len(contour) < 3:
+        raise PlannerError(f"contour_xy needs at least 3 points, got {len(contour)}")
+    moments = cv2.moments(contour.astype(np.float32))
+    if moments["m00"] == 0:
+        raise PlannerError("contour_xy encloses no area")
+    centre = np.array([moments["m10"], moments["m01"]]) / moments["m00"]
+    a, b, c = moments["mu20"], moments["mu11"], moments["mu02"]
+    spread = np.hypot(a - c, 2 * b)  # the difference of the two principal moments
+    if spread < MEMORY_ROUND * 0.5 * (a + c + spread):
+        return centre, 0.0
+    return centre, float(0.5 * np.arctan2(2 * b, a - c))
+
+
+def _rotation(angle: float) -> np.ndarray:
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s], [s, c]])
+
+
+def _wrapped(angle):
+    """Angles wrapped into [-pi, pi)."""
+    return (np.asarray(angle) + np.pi) % (2 * np.pi) - np.pi

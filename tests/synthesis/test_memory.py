@@ -1,0 +1,97 @@
+"""A memory of failed grasps (synthesis.memory): the object's frame, failures mapped through its motion, the plans
+that avoid them."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import contourgrasp as cg
+from contourgrasp import tolerances as tol
+from contourgrasp.errors import NoFeasibleGrasp, PlannerError
+from contourgrasp.io.camera_file import read_rgbd
+from contourgrasp.synthesis import GraspMemory, SearchGrid, SearchOptions, object_frame, search
+from contourgrasp.synthesis.outer import EXCLUDED
+
+FRAME = Path(__file__).resolve().parents[2] / "examples" / "bar_clamp"
+#: A 6 x 2 cm box's outline, counter-clockwise, centred at (0.03, 0.01).
+BOX = np.array([[0.0, 0.0], [0.06, 0.0], [0.06, 0.02], [0.0, 0.02]])
+
+
+def moved(points, turn, shift):
+    """``points`` (n, 2) turned by ``turn`` about the origin, then shifted."""
+    c, s = np.cos(turn), np.sin(turn)
+    return np.asarray(points) @ np.array([[c, -s], [s, c]]).T + shift
+
+
+@pytest.mark.parametrize("turn", [0.0, 0.4, -1.2, 2.5])
+def test_the_frame_is_the_centroid_and_the_long_axis_either_way_round(turn):
+    centre, angle = object_frame(moved(BOX, turn, [0.2, -0.1]))
+    np.testing.assert_allclose(centre, moved([[0.03, 0.01]], turn, [0.2, -0.1])[0], atol=1e-6)
+    assert np.sin(angle - turn) == pytest.approx(0.0, abs=1e-5)  # the long axis, mod pi
+    centre_cw, angle_cw = object_frame(moved(BOX, turn, [0.2, -0.1])[::-1])  # clockwise: the same frame
+    np.testing.assert_allclose(centre_cw, centre, atol=1e-9)
+    assert np.sin(angle_cw - angle) == pytest.approx(0.0, abs=1e-9)
+
+
+def test_a_round_outline_keeps_the_planning_frames_orientation():
+    circle = 0.03 * np.c_[np.cos(np.linspace(0, 2 * np.pi, 64, endpoint=False)),
+                          np.sin(np.linspace(0, 2 * np.pi, 64, endpoint=False))]
+    assert object_frame(circle + [0.1, 0.2])[1] == 0.0
+
+
+@pytest.mark.parametrize("turn", [0.0, 0.5, np.pi / 2])
+def test_a_failure_follows_the_object_as_it_moves_and_turns(turn):
+    failed = (0.03, 0.05, 0.3)  # beside the box's long side
+    memory = GraspMemory().with_failure(BOX, failed)
+    now = moved(BOX, turn, [0.1, 0.05])
+    there = np.r_[moved([failed[:2]], turn, [0.1, 0.05])[0], failed[2] + turn]
+    mirrored = np.r_[moved([[0.03, -0.03]], turn, [0.1, 0.05])[0], failed[2] + turn + np.pi]  # the axis's other way
+    near = there + [0.01, 0.0, 0.2]
+    far = there + [0.03, 0.0, 0.0]
+    turned = there + [0.0, 0.0, 0.5]
+    assert memory.excluded(now, [there, mirrored, near, far, turned]).tolist() == [True, True, True, False, False]
+    assert not GraspMemory().excluded(now, [there]).any() and len(memory) == 1
+
+
+def test_the_memory_keeps_the_newest_failures():
+    memory = GraspMemory()
+    for i in range(tol.MAX_MEMORY_FAILURES + 3):
+        memory = memory.with_failure(BOX, (0.001 * i, 0.0, 0.0))
+    assert len(memory) == tol.MAX_MEMORY_FAILURES
+    assert memory.failures[-1][0] == pytest.approx(0.001 * (tol.MAX_MEMORY_FAILURES + 2) - 0.03, abs=1e-9)
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda: GraspMemory().with_failure(BOX, (0.0, 0.0)), "pose"),
+    (lambda: GraspMemory().with_failure(BOX[:2], (0.0, 0.0, 0.0)), "at least 3 points"),
+    (lambda: GraspMemory().with_failure(np.zeros((4, 2)), (0.0, 0.0, 0.0)), "no area"),
+    (lambda: GraspMemory().excluded(BOX, [[0.0, np.nan, 0.0]]), "poses"),
+])
+def test_bad_input_is_a_planner_error_naming_it(call, message):
+    with pytest.raises(PlannerError, match=message):
+        call()
+
+
+def test_a_search_with_every_pose_excluded_says_so():
+    options = SearchOptions(grid=SearchGrid(yaw_step=np.radians(10)))
+    hand = cg.load_hand("three-finger")
+    with pytest.raises(NoFeasibleGrasp, match=EXCLUDED.split(" (")[0]):
+        search(cg.example_contour("can"), hand, options, exclude=lambda poses: np.ones(len(poses), bool))
+    with pytest.raises(PlannerError, match="exclude must be callable"):
+        search(cg.example_contour("can"), hand, options, exclude=3)
+
+
+def test_the_next_plan_of_the_bundled_frame_avoids_the_failed_one():
+    frame = read_rgbd(FRAME / "color_0.png", FRAME / "depth_0.npy", FRAME / "primesense_overhead_color.intr")
+    first = cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, yaw_step=0.1)
+    memory = GraspMemory().with_failure(first.metric.contour_xy, first.plan.pose)
+    second = cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, yaw_step=0.1, memory=memory)
+    assert not memory.excluded(second.metric.contour_xy, second.plan.pose[None])[0]
+    step = second.plan.pose - first.plan.pose
+    turn = abs((step[2] + np.pi) % (2 * np.pi) - np.pi)
+    assert np.hypot(*step[:2]) > tol.MEMORY_REACH or turn > tol.MEMORY_TURN
+    with pytest.raises(PlannerError, match="memory must be"):
+        cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, yaw_step=0.1, memory=[first.plan.pose])
