@@ -431,3 +431,43 @@ def test_parameters_that_fit_alone_but_not_together_are_refused_naming_them():
     with pytest.raises(InputError, match=r"^parameters .*xy_step, yaw_step_deg together: the search grid would have"):
         settings_from_parameters({"planner": "paper", "xy_step": 0.005, "yaw_step_deg": 1.0})
     assert settings_from_parameters({"planner": "paper", "xy_step": 0.005}).options.search.grid.xy_step == 0.005
+
+
+def _call(camera, kind, service, request):
+    client = camera.node.create_client(kind, service)
+    try:
+        assert client.wait_for_service(timeout_sec=TIMEOUT)
+        future = client.call_async(request)
+        assert spin_until(camera.executor, future.done, TIMEOUT), f"no answer from {service}"
+        return future.result()
+    finally:
+        camera.node.destroy_client(client)
+
+
+def test_a_failure_reported_is_avoided_by_the_next_plan_and_a_success_or_a_clear_forgets(ros, reference):
+    from std_srvs.srv import SetBool
+
+    from contourgrasp import tolerances as tol
+
+    node, camera = _started(ros, "/memory")
+    try:
+        refused = _call(camera, SetBool, "/memory/contourgrasp/report_outcome", SetBool.Request(data=False))
+        assert not refused.success and refused.message.startswith("no grasp published")
+        colour, depth, info = good_frame()
+        camera.send(node, colour, depth, info)
+        first = json.loads(camera.call().message)
+        failed = _call(camera, SetBool, "/memory/contourgrasp/report_outcome", SetBool.Request(data=False))
+        assert failed.success and "avoid the 1 failed grasp(s)" in failed.message and len(node.memory) == 1
+        second = json.loads(camera.call().message)
+        step = np.subtract([second["pose"][k] for k in ("x", "y", "yaw")], [first["pose"][k] for k in ("x", "y", "yaw")])
+        turn = abs((step[2] + np.pi) % (2 * np.pi) - np.pi)
+        assert np.hypot(*step[:2]) > tol.MEMORY_REACH or turn > tol.MEMORY_TURN  # not the failed grasp again
+        succeeded = _call(camera, SetBool, "/memory/contourgrasp/report_outcome", SetBool.Request(data=True))
+        assert succeeded.success and len(node.memory) == 0
+        camera.call()
+        _call(camera, SetBool, "/memory/contourgrasp/report_outcome", SetBool.Request(data=False))
+        cleared = _call(camera, Trigger, "/memory/contourgrasp/clear_memory", Trigger.Request())
+        assert cleared.success and len(node.memory) == 0
+        assert json.loads(camera.call().message)["pose"] == first["pose"]  # forgotten: the first plan again
+    finally:
+        _stopped(ros, node, camera)

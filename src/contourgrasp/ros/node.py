@@ -7,6 +7,12 @@ within ``pair_tolerance`` seconds; a frame without a pair is not planned on.
 
 Serves ``~/plan`` (std_srvs/Trigger): plans on the newest pair and answers the
 plan JSON of ``contourgrasp plan``, or success false with the one-line reason.
+The node keeps one memory of failed grasps for its scene
+(:class:`~contourgrasp.synthesis.GraspMemory`), which every plan avoids:
+``~/report_outcome`` (std_srvs/SetBool) tells it how the last grasp published
+went -- ``data`` false: it failed, and is remembered in the object's frame;
+true: it succeeded, the object is gone and the memory is cleared -- and
+``~/clear_memory`` (std_srvs/Trigger) clears it (a new scene).
 With ``continuous`` it plans every pair as it arrives. Parameter ``target``
 ([u, v], a pixel of the depth image; ``[-1, -1]`` for the default rule of
 :func:`contourgrasp.perception.choose_target`) names the object to plan on;
@@ -35,7 +41,7 @@ from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import CameraInfo, Image
-from std_srvs.srv import Trigger
+from std_srvs.srv import SetBool, Trigger
 from visualization_msgs.msg import MarkerArray
 
 from ..errors import InputError, NoFeasibleGrasp
@@ -44,6 +50,7 @@ from ..io.hand_file import load_hand
 from ..io.plan_file import image_plan_to_dict
 from ..io.planner_file import Planner, load_planner
 from ..pipeline import PlanOptions, plan_frame
+from ..synthesis import GraspMemory
 from ..threads import one_blas_thread
 from ..validation import with_options
 from . import messages
@@ -160,6 +167,10 @@ class ContourGraspNode(Node):
     latencies_ms : deque of float
         Per plan published, the last ``LATENCIES_KEPT``: time from the message that completed the frame
         (continuous) or the service call to the poses published, ms.
+    memory : GraspMemory
+        The scene's failed grasps (module docstring).
+    last : ImageGraspPlan or None
+        The last plan published, which ``~/report_outcome`` is about.
 
     Raises
     ------
@@ -182,7 +193,10 @@ class ContourGraspNode(Node):
         self.grasp_publisher = self.create_publisher(PoseStamped, "~/grasp", 10)
         self.pregrasp_publisher = self.create_publisher(PoseStamped, "~/pregrasp", 10)
         self.markers_publisher = self.create_publisher(MarkerArray, "~/markers", 10)
+        self.memory, self.last = GraspMemory(), None
         self.create_service(Trigger, "~/plan", self._on_plan)
+        self.create_service(SetBool, "~/report_outcome", self._on_report_outcome)
+        self.create_service(Trigger, "~/clear_memory", self._on_clear_memory)
         self.add_on_set_parameters_callback(self._on_set_parameters)
         self.get_logger().info(
             f"ready: hand {self.settings.hand.name}, planner {self.settings.planner.name}, "
@@ -245,6 +259,27 @@ class ContourGraspNode(Node):
             response.success, response.message = self.plan(self.pairer.newest, started)
         return response
 
+    def _on_report_outcome(self, request, response):
+        """The last grasp published failed (``data`` false: remembered) or succeeded (true: the memory cleared)."""
+        if self.last is None:
+            response.success, response.message = False, "no grasp published since the memory was last cleared"
+        elif request.data:
+            self.memory, self.last = GraspMemory(), None
+            response.success, response.message = True, "the grasp succeeded: the memory of failed grasps is cleared"
+        else:
+            self.memory = self.memory.with_failure(self.last.metric.contour_xy, self.last.plan.pose)
+            self.last = None  # reported once
+            response.success, response.message = True, (
+                f"the grasp failed: remembered; the next plans avoid the {len(self.memory)} failed grasp(s)")
+        self.get_logger().info(response.message)
+        return response
+
+    def _on_clear_memory(self, _request, response):
+        self.memory, self.last = GraspMemory(), None
+        response.success, response.message = True, "the memory of failed grasps is cleared"
+        self.get_logger().info(response.message)
+        return response
+
     def plan(self, pair, started: float) -> tuple[bool, str]:
         """Plan on a (colour, depth) pair and publish; (True, plan JSON) or (False, the reason, logged)."""
         colour, depth = pair
@@ -259,6 +294,7 @@ class ContourGraspNode(Node):
             reason = f"internal error (please report): {type(err).__name__}: {err}"
             self.get_logger().error(f"frame {stamp:.3f}: {reason}")
             return False, reason
+        self.last = result
         self.grasp_publisher.publish(messages.pose_stamped(result.T_camera_hand, colour.header))
         self.pregrasp_publisher.publish(messages.pose_stamped(result.T_camera_pregrasp, colour.header))
         self.markers_publisher.publish(messages.plan_markers(result, colour.header))
@@ -276,7 +312,7 @@ class ContourGraspNode(Node):
             warnings.simplefilter("always")
             rgb, d, intrinsics = messages.rgbd_arrays(colour, depth, self.camera_info)
             result = plan_frame(rgb, d, intrinsics, self.settings.hand, self.settings.options,
-                                target_px=self.settings.target_px)
+                                target_px=self.settings.target_px, memory=self.memory)
         for w in caught:
             self.get_logger().warning(str(w.message))
         return result
