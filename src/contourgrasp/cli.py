@@ -312,6 +312,9 @@ def _add_bench_parser(sub) -> None:
     bench.add_argument("--scene", choices=("single", "clutter", "bin"), default="single",
                        help="one object on the table (default), 2-4 on the table, or 1-3 in a bin: each object "
                             "in turn the target among the others of its set (see docs/bench.md, 'Clutter and bin scenes')")
+    bench.add_argument("--attempts", type=_positive_int, default=1,
+                       help="at most this many attempts per trial: a failure told from a new picture, the next "
+                            "plan avoiding the grasps that failed (1-5; default 1; docs/regrasp.md)")
 
 
 def _add_calibrate_parser(sub) -> None:
@@ -603,7 +606,7 @@ def _bench(args) -> int:
     setup = bench.Bench(objects=objects, planners=planners, trials=args.trials, seed=args.seed, hand=hand,
                         sensor=args.sensor, tilt=None if args.tilt is None else math.radians(args.tilt),
                         robot=args.robot_in_view, splits=splits, hand_model=mounted,
-                        scene_kind=args.scene)
+                        scene_kind=args.scene, attempts=args.attempts)
     journal, done = bench.resume(out, setup) if args.resume is not None else (None, ())
     with bench.executor(setup, workers=args.workers, ray=args.ray is not None, address=args.ray or None) as run:
         if journal is None:

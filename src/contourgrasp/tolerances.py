@@ -219,6 +219,16 @@ MIN_FLAT_HEIGHT = 0.0005
 #: mask; the whole image is searched only when the evidence reaches that window's edge.
 FLAT_WINDOW_PX = 96
 
+#: The bench's several attempts (sim.trial.run_trial): a picture after the hold says the object is still where it stood
+#: when, within this distance (m, on the table) of its former pixels ...
+DETECT_REACH = 0.05
+#: ... at least this share as many pixels stand on the support ...
+DETECT_SHARE = 0.5
+#: ... lower than its former top plus this (m): held at the lift's height (0.15 m) it stands higher.
+DETECT_RISE = 0.05
+#: At most this many attempts per trial (bounds the work a bench can ask for).
+MAX_ATTEMPTS = 5
+
 #: A memory of failed grasps (synthesis.memory) excludes the poses within this distance (m) of a failure mapped into
 #: the object's frame: a search grid step and a half (1 cm steps), so that the next plan is not the failure again ...
 MEMORY_REACH = 0.015

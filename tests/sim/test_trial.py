@@ -1,11 +1,13 @@
 """Grasp execution and trials: scripted good and bad grasps, the causes, determinism."""
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from contourgrasp import InputError, NoFeasibleGrasp, load_hand
+from contourgrasp.errors import SimulationError
 from contourgrasp.sim import (FAILURE_CAUSES, Camera, ObjectSpec, Part, Workspace, build_scene, execute_grasp,
                               pose_matrix, run_trial)
 from contourgrasp.sim.planners import make_planner
@@ -111,3 +113,59 @@ def test_a_grasp_planned_from_a_tilted_camera_lifts_the_can(tilt_deg):
     hand = load_hand("five-finger-linear")
     record = run_trial("can", seed=1, planner=make_planner("default", hand, seed=1), tilt=math.radians(tilt_deg))
     assert record.success, record
+
+
+class _FirstMisses:
+    """The ``default`` planner, but its first plan (an empty memory) moved 15 cm aside: it closes on air."""
+
+    def __init__(self, seed):
+        self.planner = make_planner("default", load_hand("five-finger-linear"), seed=seed)
+
+    def plan(self, rgb, depth, intrinsics, *, memory=None, **target):
+        planned = self.planner.plan(rgb, depth, intrinsics, memory=memory, **target)
+        if memory:
+            return planned
+        aside = planned.T_camera_hand.copy()
+        aside[0, 3] += 0.15
+        return replace(planned, T_camera_hand=aside)
+
+    def __call__(self, rgb, depth, intrinsics, **target):
+        planned = self.plan(rgb, depth, intrinsics, **target)
+        return planned.T_camera_hand, planned.approach_depth, planned.grasp_height
+
+
+def test_a_miss_is_told_from_the_next_picture_and_the_next_attempt_lifts_the_can():
+    record = run_trial("can", seed=1, planner=_FirstMisses(1), attempts=3)
+    assert record.outcomes == (False, True) and record.detected == (False, True)
+    assert record.success and record.cause is None
+    once = run_trial("can", seed=1, planner=_FirstMisses(1))
+    assert not once.success and once.cause == MISSED and once.outcomes == () == once.detected
+
+
+def test_several_attempts_need_a_planner_that_takes_a_memory():
+    with pytest.raises(SimulationError, match="several attempts need a planner"):
+        run_trial("can", seed=1, planner=lambda rgb, depth, intrinsics: None, attempts=2)
+    with pytest.raises(SimulationError, match="attempts must be"):
+        run_trial("can", seed=1, planner=PAPER, attempts=9)
+
+
+def test_a_picture_says_lifted_when_the_object_has_left_its_place_and_not_when_it_was_pushed():
+    from contourgrasp.perception import Intrinsics
+    from contourgrasp.sim.trial import seen_lifted
+
+    camera = Intrinsics(fx=525.0, fy=525.0, cx=79.5, cy=59.5, width=160, height=120)
+    table = np.full((120, 160), 0.7)
+    before = table.copy()
+    before[50:70, 70:90] = 0.65  # a 5 cm box
+    mask = before < 0.69
+
+    class Planned:
+        segmentation = type("Seg", (), {"mask": mask})()
+
+    Planned.camera = camera
+    pushed = table.copy()
+    pushed[50:70, 78:98] = 0.65  # 8 px (1 cm) along
+    rgb = np.zeros((120, 160, 3), np.uint8)
+    assert not seen_lifted(Planned, before, rgb, before)
+    assert not seen_lifted(Planned, before, rgb, pushed)
+    assert seen_lifted(Planned, before, rgb, table)

@@ -135,8 +135,9 @@ class SynthesisPlanner(_Planner):
 
     options: pipeline.PlanOptions = pipeline.PlanOptions()
 
-    def plan(self, rgb, depth, intrinsics, *, target_px=None) -> PlannedGrasp:
-        result = pipeline.plan_frame(rgb, depth, intrinsics, self.hand, self.options, target_px=target_px)
+    def plan(self, rgb, depth, intrinsics, *, target_px=None, memory=None) -> PlannedGrasp:
+        result = pipeline.plan_frame(rgb, depth, intrinsics, self.hand, self.options, target_px=target_px,
+                                     memory=memory)
         return PlannedGrasp(result.plan.pose, result.T_camera_hand, result.metric.approach_depth,
                             result.segmentation, result.metric, result.camera, result.plan, result.grasp_height)
 
@@ -145,7 +146,8 @@ class SynthesisPlanner(_Planner):
 class CentroidPlanner(_Planner):
     """The ``centroid-principal-axis`` baseline (module docstring)."""
 
-    def plan(self, rgb, depth, intrinsics, *, target_px=None) -> PlannedGrasp:
+    def plan(self, rgb, depth, intrinsics, *, target_px=None, memory=None) -> PlannedGrasp:
+        """The centroid's pose; ``memory`` is not used: the rule has one pose per outline."""
         segmentation, metric, _ = pipeline.perceive(rgb, depth, intrinsics, target_px=target_px)
         return _planned(centroid_pose(metric.contour_xy, self.hand), segmentation, metric, intrinsics)
 
@@ -156,9 +158,11 @@ class RandomPlanner(_Planner):
 
     seed: int = 0
 
-    def plan(self, rgb, depth, intrinsics, *, target_px=None) -> PlannedGrasp:
+    def plan(self, rgb, depth, intrinsics, *, target_px=None, memory=None) -> PlannedGrasp:
+        """A random feasible pose; with a ``memory``, another draw per failure it holds (it is not avoided)."""
         segmentation, metric, _ = pipeline.perceive(rgb, depth, intrinsics, target_px=target_px)
-        rng = np.random.default_rng([self.seed, 2])  # streams 0 and 1 place the object and add noise
+        draws = [self.seed, 2] if not memory else [self.seed, 2, len(memory)]
+        rng = np.random.default_rng(draws)  # streams 0 and 1 place the object and add noise
         pose = random_feasible_pose(metric.contour_xy, self.hand, rng, load_planner(RANDOM_REGION).options.search)
         return _planned(pose, segmentation, metric, intrinsics)
 

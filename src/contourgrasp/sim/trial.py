@@ -65,10 +65,16 @@ import time
 import warnings
 from dataclasses import asdict, dataclass, field
 
+import cv2
 import numpy as np
 
-from ..errors import ContourGraspWarning, InputError, NoFeasibleGrasp, SimulationError
+from .. import perception
+from ..errors import ContourGraspWarning, InputError, NoFeasibleGrasp, SegmentationError, SimulationError
 from ..hand import Hand
+from ..perception.table import heights
+from ..synthesis import GraspMemory
+from ..tolerances import DETECT_REACH, DETECT_RISE, DETECT_SHARE, MAX_ATTEMPTS, MIN_HEIGHT
+from ..validation import integer
 from .clutter import build_clutter, target_pixel
 from .tendon_hand import HandDesign
 from .render import DEFAULT_SENSOR, Sensor, render, tilted_view
@@ -83,6 +89,13 @@ DROPPED = "dropped"
 HIT = "hit a neighbour or the bin"
 #: Every failure cause a trial can report (HIT only in a scene of several objects).
 FAILURE_CAUSES = (NO_PLAN, STRUCK, MISSED, PUSHED, SLIPPED, DROPPED, HIT)
+#: Where the hand waits between attempts (world x, y, z of the palm, yaw), far above the table, open.
+PARKED = (0.0, 0.0, 0.6)
+#: Seconds the scene settles after a failed attempt, the hand parked, before the next picture.
+SETTLE_AFTER_FAILURE = 0.5
+#: After an attempt the closed hand is carried this far (m) along the world's y in this many seconds, out of the
+#: camera's view with what it holds, before the picture that tells whether it failed.
+CARRY_AWAY, CARRY_TIME = 0.7, 1.0
 #: Angle of the hand's x axis from the object's x axis in :func:`scripted_grasp`, rad.
 SCRIPTED_TILT = math.radians(20.0)
 
@@ -172,6 +185,10 @@ class TrialRecord:
         Seconds of wall time the planner took (left out of the comparison).
     wall_time : float
         Seconds of wall time for the whole trial (scene, picture, plan, simulation).
+    outcomes, detected : tuple of bool
+        With several attempts (:func:`run_trial`'s ``attempts``), per attempt made: whether it truly
+        succeeded, and whether the new frame after it said so (:func:`seen_lifted`); empty with one.
+        The other fields are the last attempt's, ``plan_time`` the attempts' sum.
     """
 
     object: str
@@ -190,14 +207,24 @@ class TrialRecord:
     sim_time: float
     plan_time: float = field(compare=False)
     wall_time: float = field(compare=False)
+    outcomes: tuple[bool, ...] = ()
+    detected: tuple[bool, ...] = ()
 
 
 def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finger-linear",
               sensor: Sensor | str = DEFAULT_SENSOR, tilt: float | None = None, timing: str = "thesis",
               design: HandDesign = HandDesign(), camera: Camera = Camera(),
               workspace: Workspace = Workspace(), execution: Execution = Execution(), observe=None,
-              scene_kind: str = "single", pool=(), robot: bool = False) -> TrialRecord:
+              scene_kind: str = "single", pool=(), robot: bool = False, attempts: int = 1) -> TrialRecord:
     """Place the object (seeded), take an RGB-D picture, plan, execute, and record the outcome.
+
+    With ``attempts`` above 1, a failure is told as a real robot would tell it -- a new picture after
+    the hold, in which the object still stands where it stood (:func:`seen_lifted`), not the
+    simulator's truth -- and then the hand opens and leaves, the scene settles as it is, a new
+    picture is taken and the planner tries again, remembering the grasps that failed (its ``plan``
+    takes ``memory``: :class:`~contourgrasp.synthesis.GraspMemory`), until a picture says the object
+    was lifted or ``attempts`` were made. The record is the last attempt's, with every attempt's
+    true and told outcome (``outcomes``, ``detected``).
 
     Parameters
     ----------
@@ -240,38 +267,117 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
         The neighbours of a ``clutter`` or ``bin`` scene are drawn from it.
     robot : bool
         A robot arm in the picture (:data:`~contourgrasp.sim.scene.ROBOT_ARM`), seen and never touched.
+    attempts : int
+        At most this many attempts (above).
     """
     started = time.perf_counter()
+    attempts = integer("attempts", attempts, 1, maximum=MAX_ATTEMPTS, error=SimulationError)
+    if attempts > 1 and not hasattr(planner, "plan"):
+        raise SimulationError("several attempts need a planner with a plan method that takes memory= "
+                              "(contourgrasp.sim.planners)")
     scene = trial_scene(object_spec, seed=seed, scene_kind=scene_kind, pool=pool, hand=hand, design=design,
                         timing=timing, camera=camera, workspace=workspace, robot=robot)
     if tilt is not None:
         scene.view = tilted_view(tilt, camera.height)
-    rgb, depth = render(scene, sensor=sensor, seed=seed)
+    memory, outcomes, detected, plan_time = GraspMemory(), [], [], 0.0
+    for attempt in range(attempts):
+        rgb, depth = render(scene, sensor=sensor, seed=seed if attempt == 0 else _noise_seed(seed, attempt, 0))
+        fields, plan_error, planned, spent = _attempt(scene, planner, rgb, depth, camera, execution,
+                                                      memory if attempts > 1 else None)
+        plan_time += spent
+        if attempts == 1:
+            break
+        outcomes.append(bool(fields["success"]))
+        if planned is not None:
+            _carry_away(scene)
+        after = render(scene, sensor=sensor, seed=_noise_seed(seed, attempt, 1))
+        detected.append(planned is not None and seen_lifted(planned, depth, *after))
+        if detected[-1] or planned is None:
+            break
+        memory = memory.with_failure(planned.metric.contour_xy, planned.pose)
+        scene.set_hand(*PARKED, 0.0)  # the hand opens and leaves; what it held falls where it is
+        scene.step(SETTLE_AFTER_FAILURE)
+    if observe is not None:
+        observe(scene)
+    return TrialRecord(object=scene.object.name, seed=seed, **fields, plan_error=plan_error, sim_time=scene.time,
+                       plan_time=plan_time, wall_time=time.perf_counter() - started, outcomes=tuple(outcomes),
+                       detected=tuple(detected))
+
+
+def _carry_away(scene) -> None:
+    """The closed hand, at its height, carried ``CARRY_AWAY`` (m) along the world's y in ``CARRY_TIME`` s, out of the
+    camera's view, with what it holds: where a robot shows the camera the table before it tries again."""
+    start = np.array(scene.data.qpos[scene._base_qpos], dtype=float)
+    steps = max(1, round(CARRY_TIME / scene.model.opt.timestep))
+    for k in range(steps):
+        u = (k + 1) / steps
+        scene.command(start + [0.0, CARRY_AWAY * u * u * (3 - 2 * u), 0.0, 0.0], 1.0)
+        scene.step()
+
+
+def _noise_seed(seed: int, attempt: int, picture: int) -> int:
+    """The sensor noise's seed of a later picture of a trial: the attempt's, before (0) or after (1) it."""
+    return int(np.random.SeedSequence([seed, attempt, picture]).generate_state(1)[0])
+
+
+def _attempt(scene, planner, rgb, depth, camera: Camera, execution: Execution, memory):
+    """Plan on a picture and execute: (the record's fields, the plan's error or None, the planner's
+    PlannedGrasp or None, seconds planning). ``memory``: None for the planner's call, else its ``plan``'s."""
     target = {} if scene.view is None else {"target_px": target_pixel(scene)}
-    planning = time.perf_counter()
+    planning, planned = time.perf_counter(), None
     try:
         with warnings.catch_warnings():  # a trial's record is its outcome: its perception's notes are not printed
             warnings.simplefilter("ignore", ContourGraspWarning)
-            transform, approach_depth, *planned_height = planner(rgb, depth, camera.intrinsics, **target)
+            if memory is None:
+                transform, approach_depth, *planned_height = planner(rgb, depth, camera.intrinsics, **target)
+            else:
+                planned = planner.plan(rgb, depth, camera.intrinsics, memory=memory, **target)
+                transform, approach_depth, planned_height = (planned.T_camera_hand, planned.approach_depth,
+                                                             [planned.grasp_height])
         if scene.view is not None:
             *pose, approach_depth = scene.to_reference(transform)
             transform = pose_matrix(*pose, approach_depth)
         plan_error = None
     except (NoFeasibleGrasp, InputError) as err:
-        plan_error = str(err)
-    plan_time = time.perf_counter() - planning
-    if plan_error is None:
-        grasp_height = planned_height[0] if planned_height else None
-        outcome = asdict(execute_grasp(scene, transform, approach_depth, execution, grasp_height=grasp_height))
-        fields = {k: v for k, v in outcome.items() if k != "palm_depth"} | {
-            "approach_depth": float(approach_depth), "grasp_height": None if grasp_height is None else float(grasp_height)}
-    else:
-        fields = {"success": False, "cause": NO_PLAN, "fingers_in_contact": (), "first_contact": (), "push": 0.0,
-                  "lift": 0.0, "hold_drift": 0.0, "pose": None, "approach_depth": None, "grasp_height": None}
-    if observe is not None:
-        observe(scene)
-    return TrialRecord(object=scene.object.name, seed=seed, **fields, plan_error=plan_error, sim_time=scene.time,
-                       plan_time=plan_time, wall_time=time.perf_counter() - started)
+        plan_error, planned = str(err), None
+    spent = time.perf_counter() - planning
+    if plan_error is not None:
+        return ({"success": False, "cause": NO_PLAN, "fingers_in_contact": (), "first_contact": (), "push": 0.0,
+                 "lift": 0.0, "hold_drift": 0.0, "pose": None, "approach_depth": None, "grasp_height": None},
+                plan_error, None, spent)
+    grasp_height = planned_height[0] if planned_height else None
+    outcome = asdict(execute_grasp(scene, transform, approach_depth, execution, grasp_height=grasp_height))
+    fields = {k: v for k, v in outcome.items() if k != "palm_depth"} | {
+        "approach_depth": float(approach_depth), "grasp_height": None if grasp_height is None else float(grasp_height)}
+    return fields, None, planned, spent
+
+
+def seen_lifted(planned, depth_before, rgb_after, depth_after) -> bool:
+    """Whether a new picture says a grasp lifted its object: the picture taken after the hand carried what it holds
+    out of view (:func:`_carry_away`) no longer shows the object standing where it stood.
+
+    The object stood on the pixels of ``planned.segmentation.mask`` in ``depth_before``, its top
+    ``h0`` above the support. It is still there when, within ``tolerances.DETECT_REACH`` (m, on the
+    table) of those pixels, at least ``tolerances.DETECT_SHARE`` as many pixels of ``depth_after``
+    stand on the support lower than ``h0 + tolerances.DETECT_RISE``: an object pushed a few
+    centimetres, or dropped back, is still there; one carried away leaves the table where it was.
+    ``rgb_after`` is not used.
+    """
+    intrinsics = planned.camera
+    try:
+        plane = perception.fit_table_plane(depth_after, intrinsics)
+    except SegmentationError:
+        return False
+    mask = np.asarray(planned.segmentation.mask, dtype=bool)
+    with np.errstate(invalid="ignore"):
+        before = heights(depth_before, intrinsics, plane)[mask]
+        top = float(np.nanmax(before)) if np.isfinite(before).any() else 0.0
+        after = heights(depth_after, intrinsics, plane)
+        standing = (after > MIN_HEIGHT) & (after < top + DETECT_RISE)
+    z = float(np.nanmedian(np.where(depth_before[mask] > 0, depth_before[mask], np.nan))) if mask.any() else 1.0
+    reach = max(1, int(round(DETECT_REACH * intrinsics.fx / max(z, 1e-3))))
+    near = cv2.dilate(mask.astype(np.uint8), cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * reach + 1,) * 2)) > 0
+    return int((standing & near).sum()) < DETECT_SHARE * int(mask.sum())
 
 
 def trial_scene(object_spec, *, seed: int, scene_kind: str = "single", pool=(), **options) -> Scene:

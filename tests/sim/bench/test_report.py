@@ -172,3 +172,24 @@ def test_procedural_objects_are_reported_per_family_too(tmp_path):
 
 def test_a_bench_without_procedural_objects_has_no_family_table(bench_out):
     assert "Per family" not in (bench_out / "table.md").read_text()
+
+
+def test_several_attempts_are_reported_first_within_and_as_told(tmp_path):
+    from dataclasses import replace
+
+    from contourgrasp.sim.bench import trial_from_dict, trial_to_dict
+
+    bench = Bench(objects=thesis_objects(["can", "case"]), planners=("default",), trials=2, attempts=3)
+    base = _split_results(bench, {"default": {"can": 2, "case": 0}})
+    told = {("can", 0): ((True,), (True,)), ("can", 1): ((False, True), (False, True)),
+            ("case", 0): ((False, False, False), (False, True, False)), ("case", 1): ((False,), (True,))}
+    results = [BenchTrial(r.planner, r.trial, replace(r.record, outcomes=told[r.record.object, r.trial][0],
+                                                      detected=told[r.record.object, r.trial][1]))
+               for r in base]
+    assert [trial_from_dict(trial_to_dict(r)) for r in results] == results  # the journal keeps them
+    write_outputs(bench, results, tmp_path, wall_time=1.0)
+    table = (tmp_path / "table.md").read_text()
+    assert "## Attempts (at most 3)" in table
+    assert "| default | all | 25 % (5–70) 1/4 | 50 % (15–85) 2/4 | 1.75 |" in table
+    assert "| succeeded | 2 | 2 |" in table and "| failed | 0 | 3 |" in table
+    assert "False success: 2 of 7 attempts (28.6 %)." in table

@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ...errors import SimulationError
-from ...tolerances import MAX_BENCH_TILT, MAX_BENCH_TRIALS, MAX_SEED, MAX_TRIALS
+from ...tolerances import MAX_ATTEMPTS, MAX_BENCH_TILT, MAX_BENCH_TRIALS, MAX_SEED, MAX_TRIALS
 from ...hand import Hand
 from ...io.hand_file import load_hand
 from ...validation import bounded, choice, integer
@@ -65,6 +65,9 @@ class Bench:
         The scene of every trial (:mod:`contourgrasp.sim.clutter`). In
         ``clutter`` and ``bin`` each object is in turn the target, its
         neighbours drawn from :meth:`pool`.
+    attempts : int
+        At most this many attempts per trial, a failure told from a new picture and the next plan
+        avoiding the grasps that failed (:func:`~contourgrasp.sim.trial.run_trial`).
 
     Raises
     ------
@@ -87,6 +90,7 @@ class Bench:
     splits: tuple[tuple[str, tuple[str, ...]], ...] = ()
     hand_model: object = None
     scene_kind: str = "single"
+    attempts: int = 1
 
     def __post_init__(self):
         choice("scene", self.scene_kind, SCENE_KINDS, error=SimulationError)
@@ -109,6 +113,8 @@ class Bench:
             synthesis_planner(planner)  # refuses an unknown name before any trial runs
         object.__setattr__(self, "trials", integer("trials", self.trials, 1, maximum=MAX_TRIALS, error=SimulationError))
         object.__setattr__(self, "seed", integer("seed", self.seed, 0, maximum=MAX_SEED, error=SimulationError))
+        object.__setattr__(self, "attempts", integer("attempts", self.attempts, 1, maximum=MAX_ATTEMPTS,
+                                                     error=SimulationError))
         if self.size > MAX_BENCH_TRIALS:
             raise SimulationError(f"the bench asks for {self.size} trials ({len(names)} objects x {self.trials} trials x "
                                   f"{len(self.planners)} planners): at most {MAX_BENCH_TRIALS} in one bench")
@@ -157,7 +163,8 @@ class Bench:
         return run_trial(obj, seed=seed, planner=plan or make_planner(planner, self.hand, seed=seed),
                          hand=self.hand if self.hand_model is None else self.hand_model,
                          sensor=self.sensor, tilt=self.tilt, camera=self.camera, workspace=self.workspace,
-                         observe=observe, scene_kind=self.scene_kind, pool=pool, robot=self.robot)
+                         observe=observe, scene_kind=self.scene_kind, pool=pool, robot=self.robot,
+                         attempts=self.attempts)
 
 
 @dataclass(frozen=True)

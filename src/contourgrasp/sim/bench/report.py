@@ -61,6 +61,8 @@ def trial_from_dict(data: dict) -> BenchTrial:
     fields.setdefault("grasp_height", None)  # journals written before planned grasp heights
     fields["fingers_in_contact"] = tuple(fields["fingers_in_contact"])
     fields["first_contact"] = tuple((finger, t) for finger, t in fields["first_contact"])
+    for name in ("outcomes", "detected"):  # journals written before several attempts have none
+        fields[name] = tuple(fields.get(name, ()))
     fields["pose"] = None if pose is None else (pose["x"], pose["y"], pose["yaw"])
     return BenchTrial(planner, trial, TrialRecord(**fields))
 
@@ -142,6 +144,7 @@ def markdown(bench: Bench, results, *, wall_time: float, kept: int = 0) -> str:
     for planner in bench.planners:
         lines += ["", f"## {planner}", "", *trial_table(bench, results, planner), "",
                   f"Causes of failure ({planner}):", "", *cause_table(bench, results, planner)]
+    lines += attempts_section(bench, results)
     lines += ["", "✓ success; ✗ failure and its cause: " + _cause_legend(bench) + ". " + _success_text(bench)]
     return "\n".join(lines) + "\n"
 
@@ -197,9 +200,7 @@ def _setup_text(bench: Bench, n_trials: int, wall_time: float, kept: int = 0) ->
 
 
 def _rate_cell(own) -> str:
-    wins = sum(r.success for r in own)
-    low, high = wilson_interval(wins, len(own))
-    return f"{100 * wins / len(own):.0f} % ({100 * low:.0f}–{100 * high:.0f})"
+    return _rate_cell_of([r.success for r in own])
 
 
 def rates_table(bench: Bench, results) -> list[str]:
@@ -302,6 +303,7 @@ def split_markdown(bench: Bench, results, *, wall_time: float, kept: int = 0) ->
         "",
         *object_table(bench, results),
     ]
+    lines += attempts_section(bench, results)
     families = family_table(bench, results)
     if families:
         lines += ["", "## Per family (procedural objects)", "",
@@ -392,3 +394,41 @@ def family_table(bench: Bench, results) -> list[str]:
         failures = ", ".join(f"{SHORT_CAUSES[c]} {causes.count(c)}" for c in bench.causes if c in causes)
         lines.append(_row([family, len(members[family]), *cells, failures or "—"]))
     return lines
+
+
+def attempts_section(bench: Bench, results) -> list[str]:
+    """With several attempts per trial: per planner and group, success at the first attempt and within the
+    bench's attempts and the attempts made, and how the pictures told each attempt's outcome; [] with one."""
+    if bench.attempts == 1:
+        return []
+    lines = ["", f"## Attempts (at most {bench.attempts})", "",
+             "Per trial: success at the first attempt, success within the attempts (the last attempt's: the "
+             "trial stops when a picture says the object was lifted), and the attempts made. Then every attempt "
+             "made, its outcome as the picture after it told it (detected) against the simulator's (true).", ""]
+    lines += _header("planner", ["group", "first attempt", f"within {bench.attempts}", "attempts per trial"], left=1)
+    groups = _groups(bench) if bench.splits else [("all", tuple(o.name for o in bench.objects))]
+    for planner in bench.planners:
+        for group, members in groups:
+            own = _of(results, planner, members)
+            first = [r.outcomes[0] if r.outcomes else r.success for r in own]
+            made = [max(len(r.outcomes), 1) for r in own]
+            lines.append(_row([planner, group, f"{_rate_cell_of(first)} {sum(first)}/{len(first)}",
+                               f"{_rate_cell(own)} {sum(r.success for r in own)}/{len(own)}",
+                               f"{statistics.fmean(made):.2f}" if made else "-"]))
+    pairs = [(d, t) for r in results for d, t in zip(r.record.detected, r.record.outcomes)]
+    told = {(d, t): sum(1 for p in pairs if p == (d, t)) for d in (True, False) for t in (True, False)}
+    lines += ["", *_header("detected \\ true", ["succeeded", "failed"]),
+              _row(["succeeded", told[True, True], told[True, False]]),
+              _row(["failed", told[False, True], told[False, False]]),
+              "", f"False success: {told[True, False]} of {len(pairs)} attempts "
+              f"({100 * told[True, False] / max(len(pairs), 1):.1f} %)."]
+    return lines
+
+
+def _rate_cell_of(successes) -> str:
+    """:func:`_rate_cell` of a list of booleans."""
+    n, k = len(successes), int(sum(successes))
+    if not n:
+        return "-"
+    low, high = wilson_interval(k, n)
+    return f"{100 * k / n:.0f} % ({100 * low:.0f}–{100 * high:.0f})"

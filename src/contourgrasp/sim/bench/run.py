@@ -142,12 +142,8 @@ def snapshot(bench: Bench, result: BenchTrial) -> Snapshot:
     RuntimeError
         The rerun's record differs from ``result``'s: the trial is not reproducible.
     """
-    planner = make_planner(result.planner, bench.hand, seed=bench.seed + result.trial)
-    seen = {}
-
-    def recording(rgb, depth, intrinsics, **target):
-        seen["rgb"], seen["planned"] = rgb, planner.plan(rgb, depth, intrinsics, **target)
-        return seen["planned"].T_camera_hand, seen["planned"].approach_depth, seen["planned"].grasp_height
+    recording = _Recording(make_planner(result.planner, bench.hand, seed=bench.seed + result.trial))
+    seen = recording.seen
 
     def observe(scene):
         palm, _ = scene.palm_pose()
@@ -160,6 +156,21 @@ def snapshot(bench: Bench, result: BenchTrial) -> Snapshot:
     if again != result.record:
         raise RuntimeError(f"trial {result.trial} of {result.planner} on {again.object} did not reproduce")
     return Snapshot(result, seen["rgb"], seen["planned"], *seen["view"])
+
+
+class _Recording:
+    """A trial's planner that keeps its last picture and plan in ``seen`` (``rgb``, ``planned``)."""
+
+    def __init__(self, planner):
+        self.planner, self.seen = planner, {}
+
+    def plan(self, rgb, depth, intrinsics, **options) -> PlannedGrasp:
+        self.seen["rgb"], self.seen["planned"] = rgb, self.planner.plan(rgb, depth, intrinsics, **options)
+        return self.seen["planned"]
+
+    def __call__(self, rgb, depth, intrinsics, **target):
+        planned = self.plan(rgb, depth, intrinsics, **target)
+        return planned.T_camera_hand, planned.approach_depth, planned.grasp_height
 
 
 def picked_trials(results) -> list[BenchTrial]:
