@@ -169,3 +169,6 @@ def test_a_picture_says_lifted_when_the_object_has_left_its_place_and_not_when_i
     assert not seen_lifted(Planned, before, rgb, before)
     assert not seen_lifted(Planned, before, rgb, pushed)
     assert seen_lifted(Planned, before, rgb, table)
+    rolled = table.copy()
+    rolled[50:70, 130:150] = 0.65  # 60 px (8 cm) away: gone from its place, still on the table
+    assert seen_lifted(Planned, before, rgb, rolled) and not seen_lifted(Planned, before, rgb, rolled, anywhere=True)

@@ -291,7 +291,7 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
         if planned is not None:
             _carry_away(scene)
         after = render(scene, sensor=sensor, seed=_noise_seed(seed, attempt, 1))
-        detected.append(planned is not None and seen_lifted(planned, depth, *after))
+        detected.append(planned is not None and seen_lifted(planned, depth, *after, anywhere=scene_kind == "single"))
         if detected[-1] or planned is None:
             break
         memory = memory.with_failure(planned.metric.contour_xy, planned.pose)
@@ -352,7 +352,7 @@ def _attempt(scene, planner, rgb, depth, camera: Camera, execution: Execution, m
     return fields, None, planned, spent
 
 
-def seen_lifted(planned, depth_before, rgb_after, depth_after) -> bool:
+def seen_lifted(planned, depth_before, rgb_after, depth_after, *, anywhere: bool = False) -> bool:
     """Whether a new picture says a grasp lifted its object: the picture taken after the hand carried what it holds
     out of view (:func:`_carry_away`) no longer shows the object standing where it stood.
 
@@ -361,6 +361,8 @@ def seen_lifted(planned, depth_before, rgb_after, depth_after) -> bool:
     table) of those pixels, at least ``tolerances.DETECT_SHARE`` as many pixels of ``depth_after``
     stand on the support lower than ``h0 + tolerances.DETECT_RISE``: an object pushed a few
     centimetres, or dropped back, is still there; one carried away leaves the table where it was.
+    With ``anywhere`` (a scene of one object: whatever stands on the table is it) the pixels are
+    counted over the whole picture: an object pushed or rolled farther is still there too.
     ``rgb_after`` is not used.
     """
     intrinsics = planned.camera
@@ -375,6 +377,8 @@ def seen_lifted(planned, depth_before, rgb_after, depth_after) -> bool:
         after = heights(depth_after, intrinsics, plane)
         standing = (after > MIN_HEIGHT) & (after < top + DETECT_RISE)
     z = float(np.nanmedian(np.where(depth_before[mask] > 0, depth_before[mask], np.nan))) if mask.any() else 1.0
+    if anywhere:
+        return int(standing.sum()) < DETECT_SHARE * int(mask.sum())
     reach = max(1, int(round(DETECT_REACH * intrinsics.fx / max(z, 1e-3))))
     near = cv2.dilate(mask.astype(np.uint8), cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * reach + 1,) * 2)) > 0
     return int((standing & near).sum()) < DETECT_SHARE * int(mask.sum())
