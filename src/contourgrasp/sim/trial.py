@@ -73,7 +73,7 @@ from ..errors import ContourGraspWarning, InputError, NoFeasibleGrasp, Segmentat
 from ..hand import Hand
 from ..perception.table import heights
 from ..synthesis import GraspMemory
-from ..tolerances import DETECT_REACH, DETECT_RISE, DETECT_SHARE, MAX_ATTEMPTS, MIN_HEIGHT
+from ..tolerances import DETECT_REACH, DETECT_RISE, DETECT_SHARE, MAX_ATTEMPTS
 from ..validation import integer
 from .clutter import build_clutter, target_pixel
 from .tendon_hand import HandDesign
@@ -359,7 +359,8 @@ def seen_lifted(planned, depth_before, rgb_after, depth_after, *, anywhere: bool
     The object stood on the pixels of ``planned.segmentation.mask`` in ``depth_before``, its top
     ``h0`` above the support. It is still there when, within ``tolerances.DETECT_REACH`` (m, on the
     table) of those pixels, at least ``tolerances.DETECT_SHARE`` as many pixels of ``depth_after``
-    stand on the support lower than ``h0 + tolerances.DETECT_RISE``: an object pushed a few
+    belong to objects standing on the support (:func:`~contourgrasp.perception.find_candidates`)
+    whose top is lower than ``h0 + tolerances.DETECT_RISE``: an object pushed a few
     centimetres, or dropped back, is still there; one carried away leaves the table where it was.
     With ``anywhere`` (a scene of one object: whatever stands on the table is it) the pixels are
     counted over the whole picture: an object pushed or rolled farther is still there too.
@@ -373,9 +374,11 @@ def seen_lifted(planned, depth_before, rgb_after, depth_after, *, anywhere: bool
     mask = np.asarray(planned.segmentation.mask, dtype=bool)
     with np.errstate(invalid="ignore"):
         before = heights(depth_before, intrinsics, plane)[mask]
-        top = float(np.nanmax(before)) if np.isfinite(before).any() else 0.0
-        after = heights(depth_after, intrinsics, plane)
-        standing = (after > MIN_HEIGHT) & (after < top + DETECT_RISE)
+    top = float(np.nanmax(before)) if np.isfinite(before).any() else 0.0
+    standing = np.zeros(mask.shape, dtype=bool)  # what stands on the support, as perception finds it (no speckle)
+    for candidate in perception.find_candidates(depth_after, intrinsics, plane):
+        if candidate.height < top + DETECT_RISE:
+            standing |= candidate.mask
     z = float(np.nanmedian(np.where(depth_before[mask] > 0, depth_before[mask], np.nan))) if mask.any() else 1.0
     if anywhere:
         return int(standing.sum()) < DETECT_SHARE * int(mask.sum())
