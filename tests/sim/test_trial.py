@@ -154,21 +154,24 @@ def test_a_picture_says_lifted_when_the_object_has_left_its_place_and_not_when_i
     from contourgrasp.sim.trial import seen_lifted
 
     camera = Intrinsics(fx=525.0, fy=525.0, cx=79.5, cy=59.5, width=160, height=120)
-    table = np.full((120, 160), 0.7)
-    before = table.copy()
-    before[50:70, 70:90] = 0.65  # a 5 cm box
-    mask = before < 0.69
+
+    def frame(box=None, height=0.05):
+        depth, rgb = np.full((120, 160), 0.7), np.full((120, 160, 3), 200, np.uint8)
+        if box is not None:
+            depth[box] -= height
+            rgb[box] = (40, 60, 160)
+        return rgb, depth
+
+    before = frame(np.s_[50:70, 70:90])
 
     class Planned:
-        segmentation = type("Seg", (), {"mask": mask})()
+        segmentation = type("Seg", (), {"mask": before[1] < 0.69})()
 
     Planned.camera = camera
-    pushed = table.copy()
-    pushed[50:70, 78:98] = 0.65  # 8 px (1 cm) along
-    rgb = np.zeros((120, 160, 3), np.uint8)
-    assert not seen_lifted(Planned, before, rgb, before)
-    assert not seen_lifted(Planned, before, rgb, pushed)
-    assert seen_lifted(Planned, before, rgb, table)
-    rolled = table.copy()
-    rolled[50:70, 130:150] = 0.65  # 60 px (8 cm) away: gone from its place, still on the table
-    assert seen_lifted(Planned, before, rgb, rolled) and not seen_lifted(Planned, before, rgb, rolled, anywhere=True)
+    assert not seen_lifted(Planned, before, before)  # unmoved
+    assert not seen_lifted(Planned, before, frame(np.s_[50:70, 78:98]))  # pushed 8 px (1 cm)
+    assert seen_lifted(Planned, before, frame())  # gone
+    rolled = frame(np.s_[50:70, 130:150])  # 60 px (8 cm) away: gone from its place, still on the table
+    assert seen_lifted(Planned, before, rolled) and not seen_lifted(Planned, before, rolled, anywhere=True)
+    flat = frame(np.s_[50:70, 70:90], height=0.004)  # a thin object depth does not see: its colour still there
+    assert not seen_lifted(Planned, flat, flat) and seen_lifted(Planned, flat, frame())

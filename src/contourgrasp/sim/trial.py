@@ -73,7 +73,7 @@ from ..errors import ContourGraspWarning, InputError, NoFeasibleGrasp, Segmentat
 from ..hand import Hand
 from ..perception.table import heights
 from ..synthesis import GraspMemory
-from ..tolerances import DETECT_REACH, DETECT_RISE, DETECT_SHARE, MAX_ATTEMPTS
+from ..tolerances import DETECT_COLOUR, DETECT_REACH, DETECT_RISE, DETECT_SHARE, MAX_ATTEMPTS
 from ..validation import integer
 from .clutter import build_clutter, target_pixel
 from .tendon_hand import HandDesign
@@ -291,7 +291,8 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
         if planned is not None:
             _carry_away(scene)
         after = render(scene, sensor=sensor, seed=_noise_seed(seed, attempt, 1))
-        detected.append(planned is not None and seen_lifted(planned, depth, *after, anywhere=scene_kind == "single"))
+        detected.append(planned is not None and seen_lifted(planned, (rgb, depth), after,
+                                                            anywhere=scene_kind == "single"))
         if detected[-1] or planned is None:
             break
         memory = memory.with_failure(planned.metric.contour_xy, planned.pose)
@@ -352,26 +353,33 @@ def _attempt(scene, planner, rgb, depth, camera: Camera, execution: Execution, m
     return fields, None, planned, spent
 
 
-def seen_lifted(planned, depth_before, rgb_after, depth_after, *, anywhere: bool = False) -> bool:
+def seen_lifted(planned, before, after, *, anywhere: bool = False) -> bool:
     """Whether a new picture says a grasp lifted its object: the picture taken after the hand carried what it holds
     out of view (:func:`_carry_away`) no longer shows the object standing where it stood.
 
-    The object stood on the pixels of ``planned.segmentation.mask`` in ``depth_before``, its top
-    ``h0`` above the support. It is still there when, within ``tolerances.DETECT_REACH`` (m, on the
-    table) of those pixels, at least ``tolerances.DETECT_SHARE`` as many pixels of ``depth_after``
-    belong to objects standing on the support (:func:`~contourgrasp.perception.find_candidates`)
-    whose top is lower than ``h0 + tolerances.DETECT_RISE``: an object pushed a few
-    centimetres, or dropped back, is still there; one carried away leaves the table where it was.
-    With ``anywhere`` (a scene of one object: whatever stands on the table is it) the pixels are
-    counted over the whole picture: an object pushed or rolled farther is still there too.
-    ``rgb_after`` is not used.
+    ``before`` and ``after`` are the (rgb, depth) pictures of the attempt's plan and after it. The
+    object stood on the pixels of ``planned.segmentation.mask`` before, its top ``h0`` above the
+    support. It is still there when at least ``tolerances.DETECT_SHARE`` of those pixels show the same
+    colour after (CIELAB within ``tolerances.DETECT_COLOUR``: it has not moved; a thin object depth
+    does not see is told so too), or when, within ``tolerances.DETECT_REACH`` (m, on the table) of
+    those pixels, at least that share as many pixels belong to objects standing on the support
+    (:func:`~contourgrasp.perception.find_candidates`) whose top is lower than
+    ``h0 + tolerances.DETECT_RISE``: an object pushed a few centimetres, or dropped back, is still
+    there; one carried away leaves the table where it was. With ``anywhere`` (a scene of one object:
+    whatever stands on the table is it) the standing pixels are counted over the whole picture: an
+    object pushed or rolled farther is still there too.
     """
+    (rgb_before, depth_before), (rgb_after, depth_after) = before, after
     intrinsics = planned.camera
     try:
         plane = perception.fit_table_plane(depth_after, intrinsics)
     except SegmentationError:
         return False
     mask = np.asarray(planned.segmentation.mask, dtype=bool)
+    lab = [cv2.cvtColor(np.ascontiguousarray(image), cv2.COLOR_RGB2Lab)[mask].astype(float)
+           for image in (rgb_before, rgb_after)]
+    if np.mean(np.linalg.norm(lab[0] - lab[1], axis=1) < DETECT_COLOUR) >= DETECT_SHARE:
+        return False  # unmoved
     with np.errstate(invalid="ignore"):
         before = heights(depth_before, intrinsics, plane)[mask]
     top = float(np.nanmax(before)) if np.isfinite(before).any() else 0.0
