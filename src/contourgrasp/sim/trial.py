@@ -366,8 +366,9 @@ def seen_lifted(planned, before, after, *, anywhere: bool = False) -> bool:
     (:func:`~contourgrasp.perception.find_candidates`) whose top is lower than
     ``h0 + tolerances.DETECT_RISE``: an object pushed a few centimetres, or dropped back, is still
     there; one carried away leaves the table where it was. With ``anywhere`` (a scene of one object:
-    whatever stands on the table is it) the standing pixels are counted over the whole picture: an
-    object pushed or rolled farther is still there too.
+    whatever stands on the table is it) the standing pixels are counted over the whole picture, and so
+    are the pixels of the object's colour (its former pixels' median): an object pushed or rolled
+    farther, thin or not, is still there too.
     """
     (rgb_before, depth_before), (rgb_after, depth_after) = before, after
     intrinsics = planned.camera
@@ -376,10 +377,14 @@ def seen_lifted(planned, before, after, *, anywhere: bool = False) -> bool:
     except SegmentationError:
         return False
     mask = np.asarray(planned.segmentation.mask, dtype=bool)
-    lab = [cv2.cvtColor(np.ascontiguousarray(image), cv2.COLOR_RGB2Lab)[mask].astype(float)
-           for image in (rgb_before, rgb_after)]
-    if np.mean(np.linalg.norm(lab[0] - lab[1], axis=1) < DETECT_COLOUR) >= DETECT_SHARE:
+    lab_before, lab_after = (cv2.cvtColor(np.ascontiguousarray(image), cv2.COLOR_RGB2Lab).astype(float)
+                             for image in (rgb_before, rgb_after))
+    if np.mean(np.linalg.norm(lab_before[mask] - lab_after[mask], axis=1) < DETECT_COLOUR) >= DETECT_SHARE:
         return False  # unmoved
+    if anywhere:  # its colour anywhere in view: pushed or rolled, thin or not
+        colour = np.median(lab_before[mask], axis=0)
+        if (np.linalg.norm(lab_after - colour, axis=2) < DETECT_COLOUR).sum() >= DETECT_SHARE * mask.sum():
+            return False
     with np.errstate(invalid="ignore"):
         before = heights(depth_before, intrinsics, plane)[mask]
     top = float(np.nanmax(before)) if np.isfinite(before).any() else 0.0
