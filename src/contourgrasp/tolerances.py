@@ -227,6 +227,9 @@ DETECT_SHARE = 0.5
 #: ... or that share of its former pixels keep their colour within this CIELAB distance (OpenCV's 8-bit scale): it has
 #: not moved (the sensor's picture noise is in depth; the bench's colour is exact).
 DETECT_COLOUR = 12.0
+#: ... which is told only of an object whose colour lies at least this far (CIELAB) from what surrounds it: a ball as
+#: light as the table would look unmoved once lifted.
+DETECT_CONTRAST = 30.0
 #: ... lower than its former top plus this (m): held at the lift's height (0.15 m) it stands higher.
 DETECT_RISE = 0.05
 #: At most this many attempts per trial (bounds the work a bench can ask for).

@@ -73,7 +73,7 @@ from ..errors import ContourGraspWarning, InputError, NoFeasibleGrasp, Segmentat
 from ..hand import Hand
 from ..perception.table import heights
 from ..synthesis import GraspMemory
-from ..tolerances import DETECT_COLOUR, DETECT_REACH, DETECT_RISE, DETECT_SHARE, MAX_ATTEMPTS
+from ..tolerances import DETECT_COLOUR, DETECT_CONTRAST, DETECT_REACH, DETECT_RISE, DETECT_SHARE, MAX_ATTEMPTS
 from ..validation import integer
 from .clutter import build_clutter, target_pixel
 from .tendon_hand import HandDesign
@@ -305,6 +305,14 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
                        detected=tuple(detected))
 
 
+def _surroundings(lab, mask) -> np.ndarray:
+    """(3,) the median colour of a ring 3-10 px around ``mask`` in the image ``lab`` (what the object stands on)."""
+    outer, inner = (cv2.dilate(mask.astype(np.uint8), cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (n, n))) > 0
+                    for n in (21, 7))
+    ring = outer & ~inner
+    return np.median(lab[ring], axis=0) if ring.any() else np.full(3, np.inf)
+
+
 def _carry_away(scene) -> None:
     """The closed hand, at its height, carried ``CARRY_AWAY`` (m) along the world's y in ``CARRY_TIME`` s, out of the
     camera's view, with what it holds: where a robot shows the camera the table before it tries again."""
@@ -361,7 +369,8 @@ def seen_lifted(planned, before, after, *, anywhere: bool = False) -> bool:
     object stood on the pixels of ``planned.segmentation.mask`` before, its top ``h0`` above the
     support. It is still there when at least ``tolerances.DETECT_SHARE`` of those pixels show the same
     colour after (CIELAB within ``tolerances.DETECT_COLOUR``: it has not moved; a thin object depth
-    does not see is told so too), or when, within ``tolerances.DETECT_REACH`` (m, on the table) of
+    does not see is told so too) -- when its colour differs from what surrounds it by at least
+    ``tolerances.DETECT_CONTRAST``, or the table would look the same --, or when, within ``tolerances.DETECT_REACH`` (m, on the table) of
     those pixels, at least that share as many pixels belong to objects standing on the support
     (:func:`~contourgrasp.perception.find_candidates`) whose top is lower than
     ``h0 + tolerances.DETECT_RISE``: an object pushed a few centimetres, or dropped back, is still
@@ -379,12 +388,13 @@ def seen_lifted(planned, before, after, *, anywhere: bool = False) -> bool:
     mask = np.asarray(planned.segmentation.mask, dtype=bool)
     lab_before, lab_after = (cv2.cvtColor(np.ascontiguousarray(image), cv2.COLOR_RGB2Lab).astype(float)
                              for image in (rgb_before, rgb_after))
-    if np.mean(np.linalg.norm(lab_before[mask] - lab_after[mask], axis=1) < DETECT_COLOUR) >= DETECT_SHARE:
-        return False  # unmoved
-    if anywhere:  # its colour anywhere in view: pushed or rolled, thin or not
-        colour = np.median(lab_before[mask], axis=0)
-        if (np.linalg.norm(lab_after - colour, axis=2) < DETECT_COLOUR).sum() >= DETECT_SHARE * mask.sum():
-            return False
+    colour = np.median(lab_before[mask], axis=0)
+    if np.linalg.norm(colour - _surroundings(lab_before, mask)) >= DETECT_CONTRAST:  # colour tells it from the table
+        if np.mean(np.linalg.norm(lab_before[mask] - lab_after[mask], axis=1) < DETECT_COLOUR) >= DETECT_SHARE:
+            return False  # unmoved
+        if anywhere and (np.linalg.norm(lab_after - colour, axis=2) < DETECT_COLOUR).sum() >= \
+                DETECT_SHARE * mask.sum():
+            return False  # its colour elsewhere in view: pushed or rolled, thin or not
     with np.errstate(invalid="ignore"):
         before = heights(depth_before, intrinsics, plane)[mask]
     top = float(np.nanmax(before)) if np.isfinite(before).any() else 0.0
