@@ -155,11 +155,11 @@ def test_a_picture_says_lifted_when_the_object_has_left_its_place_and_not_when_i
 
     camera = Intrinsics(fx=525.0, fy=525.0, cx=79.5, cy=59.5, width=160, height=120)
 
-    def frame(box=None, height=0.05):
+    def frame(box=None, height=0.05, colour=(40, 60, 160)):
         depth, rgb = np.full((120, 160), 0.7), np.full((120, 160, 3), 200, np.uint8)
         if box is not None:
             depth[box] -= height
-            rgb[box] = (40, 60, 160)
+            rgb[box] = colour
         return rgb, depth
 
     before = frame(np.s_[50:70, 70:90])
@@ -175,3 +175,5 @@ def test_a_picture_says_lifted_when_the_object_has_left_its_place_and_not_when_i
     assert seen_lifted(Planned, before, rolled) and not seen_lifted(Planned, before, rolled, anywhere=True)
     flat = frame(np.s_[50:70, 70:90], height=0.004)  # a thin object depth does not see: its colour still there
     assert not seen_lifted(Planned, flat, flat) and seen_lifted(Planned, flat, frame())
+    pale = frame(np.s_[50:70, 70:90], colour=(205, 200, 195))  # as light as the table: its colour tells nothing
+    assert seen_lifted(Planned, pale, frame(), anywhere=True) and not seen_lifted(Planned, pale, pale, anywhere=True)

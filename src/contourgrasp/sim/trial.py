@@ -73,7 +73,7 @@ from ..errors import ContourGraspWarning, InputError, NoFeasibleGrasp, Segmentat
 from ..hand import Hand
 from ..perception.table import heights
 from ..synthesis import GraspMemory
-from ..tolerances import DETECT_COLOUR, DETECT_CONTRAST, DETECT_REACH, DETECT_RISE, DETECT_SHARE, MAX_ATTEMPTS
+from ..tolerances import DETECT_COLOUR, DETECT_CONTRAST, DETECT_REACH, DETECT_RISE, DETECT_SHARE, MAX_ATTEMPTS, MIN_HEIGHT
 from ..validation import integer
 from .clutter import build_clutter, target_pixel
 from .tendon_hand import HandDesign
@@ -305,6 +305,14 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
                        detected=tuple(detected))
 
 
+def _seen_elsewhere(lab, colour, depth, intrinsics, plane, count) -> bool:
+    """Whether at least ``DETECT_SHARE * count`` pixels on or above the support (not the floor beyond the table)
+    show ``colour`` within ``DETECT_COLOUR``."""
+    with np.errstate(invalid="ignore"):
+        on_support = heights(depth, intrinsics, plane) > -MIN_HEIGHT
+    return int(((np.linalg.norm(lab - colour, axis=2) < DETECT_COLOUR) & on_support).sum()) >= DETECT_SHARE * count
+
+
 def _surroundings(lab, mask) -> np.ndarray:
     """(3,) the median colour of a ring 3-10 px around ``mask`` in the image ``lab`` (what the object stands on)."""
     outer, inner = (cv2.dilate(mask.astype(np.uint8), cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (n, n))) > 0
@@ -376,8 +384,8 @@ def seen_lifted(planned, before, after, *, anywhere: bool = False) -> bool:
     ``h0 + tolerances.DETECT_RISE``: an object pushed a few centimetres, or dropped back, is still
     there; one carried away leaves the table where it was. With ``anywhere`` (a scene of one object:
     whatever stands on the table is it) the standing pixels are counted over the whole picture, and so
-    are the pixels of the object's colour (its former pixels' median): an object pushed or rolled
-    farther, thin or not, is still there too.
+    are the pixels of the object's colour (its former pixels' median) on or above the support (not the
+    floor beyond the table): an object pushed or rolled farther, thin or not, is still there too.
     """
     (rgb_before, depth_before), (rgb_after, depth_after) = before, after
     intrinsics = planned.camera
@@ -392,9 +400,8 @@ def seen_lifted(planned, before, after, *, anywhere: bool = False) -> bool:
     if np.linalg.norm(colour - _surroundings(lab_before, mask)) >= DETECT_CONTRAST:  # colour tells it from the table
         if np.mean(np.linalg.norm(lab_before[mask] - lab_after[mask], axis=1) < DETECT_COLOUR) >= DETECT_SHARE:
             return False  # unmoved
-        if anywhere and (np.linalg.norm(lab_after - colour, axis=2) < DETECT_COLOUR).sum() >= \
-                DETECT_SHARE * mask.sum():
-            return False  # its colour elsewhere in view: pushed or rolled, thin or not
+        if anywhere and _seen_elsewhere(lab_after, colour, depth_after, intrinsics, plane, mask.sum()):
+            return False  # its colour elsewhere on the table: pushed or rolled, thin or not
     with np.errstate(invalid="ignore"):
         before = heights(depth_before, intrinsics, plane)[mask]
     top = float(np.nanmax(before)) if np.isfinite(before).any() else 0.0
