@@ -73,7 +73,8 @@ from ..errors import ContourGraspWarning, InputError, NoFeasibleGrasp, Segmentat
 from ..hand import Hand
 from ..perception.table import heights
 from ..synthesis import GraspMemory
-from ..tolerances import DETECT_COLOUR, DETECT_CONTRAST, DETECT_REACH, DETECT_RISE, DETECT_SHARE, MAX_ATTEMPTS, MIN_HEIGHT
+from ..tolerances import (DETECT_COLOUR, DETECT_CONTRAST, DETECT_REACH, DETECT_RISE, DETECT_SHARE, LIGHTNESS_WEIGHT,
+                          MAX_ATTEMPTS, MIN_HEIGHT)
 from ..validation import integer
 from .clutter import build_clutter, target_pixel
 from .tendon_hand import HandDesign
@@ -307,10 +308,16 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
 
 def _seen_elsewhere(lab, colour, depth, intrinsics, plane, count) -> bool:
     """Whether at least ``DETECT_SHARE * count`` pixels on or above the support (not the floor beyond the table)
-    show ``colour`` within ``DETECT_COLOUR``."""
+    show ``colour`` within ``DETECT_COLOUR``, lightness weighted (:func:`_hued`)."""
     with np.errstate(invalid="ignore"):
         on_support = heights(depth, intrinsics, plane) > -MIN_HEIGHT
-    return int(((np.linalg.norm(lab - colour, axis=2) < DETECT_COLOUR) & on_support).sum()) >= DETECT_SHARE * count
+    return int(((np.linalg.norm(_hued(lab - colour), axis=-1) < DETECT_COLOUR) & on_support).sum()) >= \
+        DETECT_SHARE * count
+
+
+def _hued(lab_difference):
+    """CIELAB differences with the lightness weighted by ``LIGHTNESS_WEIGHT`` (as the flat parts' colour evidence)."""
+    return np.asarray(lab_difference) * [LIGHTNESS_WEIGHT, 1.0, 1.0]
 
 
 def _surroundings(lab, mask) -> np.ndarray:
@@ -384,8 +391,10 @@ def seen_lifted(planned, before, after, *, anywhere: bool = False) -> bool:
     ``h0 + tolerances.DETECT_RISE``: an object pushed a few centimetres, or dropped back, is still
     there; one carried away leaves the table where it was. With ``anywhere`` (a scene of one object:
     whatever stands on the table is it) the standing pixels are counted over the whole picture, and so
-    are the pixels of the object's colour (its former pixels' median) on or above the support (not the
-    floor beyond the table): an object pushed or rolled farther, thin or not, is still there too.
+    are the pixels of the object's colour (its former pixels' median; its lightness weighted as the flat
+    parts' colour evidence weighs it, since the table's shading changes the table's) on or above the
+    support (not the floor beyond the table), where that weighted colour stands out from what
+    surrounded the object: an object pushed or rolled farther, thin or not, is still there too.
     """
     (rgb_before, depth_before), (rgb_after, depth_after) = before, after
     intrinsics = planned.camera
@@ -396,12 +405,14 @@ def seen_lifted(planned, before, after, *, anywhere: bool = False) -> bool:
     mask = np.asarray(planned.segmentation.mask, dtype=bool)
     lab_before, lab_after = (cv2.cvtColor(np.ascontiguousarray(image), cv2.COLOR_RGB2Lab).astype(float)
                              for image in (rgb_before, rgb_after))
-    colour = np.median(lab_before[mask], axis=0)
-    if np.linalg.norm(colour - _surroundings(lab_before, mask)) >= DETECT_CONTRAST:  # colour tells it from the table
+    colour, around = np.median(lab_before[mask], axis=0), _surroundings(lab_before, mask)
+    if np.linalg.norm(colour - around) >= DETECT_CONTRAST:  # colour tells it from the table
         if np.mean(np.linalg.norm(lab_before[mask] - lab_after[mask], axis=1) < DETECT_COLOUR) >= DETECT_SHARE:
             return False  # unmoved
-        if anywhere and _seen_elsewhere(lab_after, colour, depth_after, intrinsics, plane, mask.sum()):
-            return False  # its colour elsewhere on the table: pushed or rolled, thin or not
+    # elsewhere, the table's shading changes its lightness as much as a grey object differs from it: hue tells
+    if anywhere and np.linalg.norm(_hued(colour - around)) >= DETECT_CONTRAST and \
+            _seen_elsewhere(lab_after, colour, depth_after, intrinsics, plane, mask.sum()):
+        return False  # its colour elsewhere on the table: pushed or rolled, thin or not
     with np.errstate(invalid="ignore"):
         before = heights(depth_before, intrinsics, plane)[mask]
     top = float(np.nanmax(before)) if np.isfinite(before).any() else 0.0
