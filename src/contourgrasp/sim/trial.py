@@ -385,8 +385,8 @@ def seen_lifted(planned, before, after, *, anywhere: bool = False) -> bool:
     support. It is still there when at least ``tolerances.DETECT_SHARE`` of those pixels show the same
     colour after (CIELAB within ``tolerances.DETECT_COLOUR``: it has not moved; a thin object depth
     does not see is told so too) -- when its colour differs from what surrounds it by at least
-    ``tolerances.DETECT_CONTRAST``, or the table would look the same --, or when, within ``tolerances.DETECT_REACH`` (m, on the table) of
-    those pixels, at least that share as many pixels belong to objects standing on the support
+    ``tolerances.DETECT_CONTRAST``, or the table would look the same --, or when, within
+    ``tolerances.DETECT_REACH`` (m, on the table) of those pixels, at least that share as many pixels belong to objects standing on the support
     (:func:`~contourgrasp.perception.find_candidates`) whose top is lower than
     ``h0 + tolerances.DETECT_RISE``: an object pushed a few centimetres, or dropped back, is still
     there; one carried away leaves the table where it was. With ``anywhere`` (a scene of one object:
@@ -396,36 +396,45 @@ def seen_lifted(planned, before, after, *, anywhere: bool = False) -> bool:
     support (not the floor beyond the table), where that weighted colour stands out from what
     surrounded the object: an object pushed or rolled farther, thin or not, is still there too.
     """
-    (rgb_before, depth_before), (rgb_after, depth_after) = before, after
     intrinsics = planned.camera
     try:
-        plane = perception.fit_table_plane(depth_after, intrinsics)
+        plane = perception.fit_table_plane(after[1], intrinsics)
     except SegmentationError:
-        return False
+        return False  # no table in view: nothing told
     mask = np.asarray(planned.segmentation.mask, dtype=bool)
+    return not (_colour_still_there(before[0], after, mask, intrinsics, plane, anywhere)
+                or _still_standing(before[1], after[1], mask, intrinsics, plane, anywhere))
+
+
+def _colour_still_there(rgb_before, after, mask, intrinsics, plane, anywhere: bool) -> bool:
+    """:func:`seen_lifted`'s colour tests: the object's pixels unmoved, or (``anywhere``) its colour elsewhere."""
     lab_before, lab_after = (cv2.cvtColor(np.ascontiguousarray(image), cv2.COLOR_RGB2Lab).astype(float)
-                             for image in (rgb_before, rgb_after))
+                             for image in (rgb_before, after[0]))
     colour, around = np.median(lab_before[mask], axis=0), _surroundings(lab_before, mask)
-    if np.linalg.norm(colour - around) >= DETECT_CONTRAST:  # colour tells it from the table
-        if np.mean(np.linalg.norm(lab_before[mask] - lab_after[mask], axis=1) < DETECT_COLOUR) >= DETECT_SHARE:
-            return False  # unmoved
+    if np.linalg.norm(colour - around) >= DETECT_CONTRAST and \
+            np.mean(np.linalg.norm(lab_before[mask] - lab_after[mask], axis=1) < DETECT_COLOUR) >= DETECT_SHARE:
+        return True  # unmoved
     # elsewhere, the table's shading changes its lightness as much as a grey object differs from it: hue tells
-    if anywhere and np.linalg.norm(_hued(colour - around)) >= DETECT_CONTRAST and \
-            _seen_elsewhere(lab_after, colour, depth_after, intrinsics, plane, mask.sum()):
-        return False  # its colour elsewhere on the table: pushed or rolled, thin or not
+    return anywhere and np.linalg.norm(_hued(colour - around)) >= DETECT_CONTRAST and \
+        _seen_elsewhere(lab_after, colour, after[1], intrinsics, plane, mask.sum())
+
+
+def _still_standing(depth_before, depth_after, mask, intrinsics, plane, anywhere: bool) -> bool:
+    """:func:`seen_lifted`'s depth test: as many pixels of objects standing on the support, no taller than it was,
+    near its former pixels (``anywhere``: in the whole picture)."""
     with np.errstate(invalid="ignore"):
-        before = heights(depth_before, intrinsics, plane)[mask]
-    top = float(np.nanmax(before)) if np.isfinite(before).any() else 0.0
-    standing = np.zeros(mask.shape, dtype=bool)  # what stands on the support, as perception finds it (no speckle)
+        former = heights(depth_before, intrinsics, plane)[mask]
+    top = float(np.nanmax(former)) if np.isfinite(former).any() else 0.0
+    standing = np.zeros(mask.shape, dtype=bool)  # as perception finds it: no speckle
     for candidate in perception.find_candidates(depth_after, intrinsics, plane):
         if candidate.height < top + DETECT_RISE:
             standing |= candidate.mask
-    z = float(np.nanmedian(np.where(depth_before[mask] > 0, depth_before[mask], np.nan))) if mask.any() else 1.0
-    if anywhere:
-        return int(standing.sum()) < DETECT_SHARE * int(mask.sum())
-    reach = max(1, int(round(DETECT_REACH * intrinsics.fx / max(z, 1e-3))))
-    near = cv2.dilate(mask.astype(np.uint8), cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * reach + 1,) * 2)) > 0
-    return int((standing & near).sum()) < DETECT_SHARE * int(mask.sum())
+    if not anywhere:
+        z = float(np.nanmedian(np.where(depth_before[mask] > 0, depth_before[mask], np.nan))) if mask.any() else 1.0
+        reach = max(1, int(round(DETECT_REACH * intrinsics.fx / max(z, 1e-3))))
+        standing &= cv2.dilate(mask.astype(np.uint8),
+                               cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * reach + 1,) * 2)) > 0
+    return int(standing.sum()) >= DETECT_SHARE * int(mask.sum())
 
 
 def trial_scene(object_spec, *, seed: int, scene_kind: str = "single", pool=(), **options) -> Scene:
