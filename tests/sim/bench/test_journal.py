@@ -135,6 +135,20 @@ def test_the_scene_is_a_setting_only_when_it_is_not_single():
         == "bin"
 
 
+def test_attempts_are_a_setting_only_when_several_and_their_outcomes_are_kept():
+    from dataclasses import replace
+
+    from contourgrasp.sim.bench import trial_to_dict
+    from contourgrasp.sim.bench.journal import _TrialLine
+
+    assert "attempts" not in settings(Bench(objects=thesis_objects(["can"]), planners=("paper",), trials=1))
+    assert settings(Bench(objects=thesis_objects(["can"]), planners=("paper",), trials=1, attempts=3))["attempts"] == 3
+    result = BenchTrial("paper", 3, replace(TrialRecord(**RECORD), outcomes=(False, True), detected=(False, True)))
+    line = json.loads(json.dumps(trial_to_dict(result)))
+    _TrialLine.model_validate(line)  # the journal's schema takes them
+    assert trial_from_dict(line) == result
+
+
 def _journal_with(tmp_path, line: bytes, header: bytes | None = None):
     """A journal of a one-trial bench whose trial line (or header) is ``line`` (``header``), and that bench."""
     from contourgrasp.sim.bench import Journal

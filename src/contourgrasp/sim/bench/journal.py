@@ -58,6 +58,8 @@ class _TrialLine(BaseModel):
     plan_time: float
     wall_time: float
     pose: _Pose | None
+    outcomes: list[bool] = []
+    detected: list[bool] = []
 
 
 def settings(bench: Bench) -> dict:
@@ -65,8 +67,8 @@ def settings(bench: Bench) -> dict:
 
     Object and hand geometry, planner options and scene parameters enter as
     short digests beside the names a reader recognises. The scene's kind is
-    named only when it is not ``single``, so journals written before there
-    were kinds resume.
+    named only when it is not ``single``, and the attempts only when more than
+    one, so journals written before there were kinds or attempts resume.
     """
     kind = {} if bench.scene_kind == "single" else {"scene": bench.scene_kind}
     return kind | {
@@ -80,6 +82,7 @@ def settings(bench: Bench) -> dict:
         "sensor": bench.sensor,
         **({} if bench.tilt is None else {"tilt": bench.tilt}),
         **({"robot in view": True} if bench.robot else {}),
+        **({"attempts": bench.attempts} if bench.attempts > 1 else {}),
         "camera": digest(bench.camera),
         "workspace": digest(bench.workspace),
         **({} if bench.hand_model is None else
