@@ -175,5 +175,12 @@ def test_a_picture_says_lifted_when_the_object_has_left_its_place_and_not_when_i
     assert seen_lifted(Planned, before, rolled) and not seen_lifted(Planned, before, rolled, anywhere=True)
     flat = frame(np.s_[50:70, 70:90], height=0.004)  # a thin object depth does not see: its colour still there
     assert not seen_lifted(Planned, flat, flat) and seen_lifted(Planned, flat, frame())
+    neighbour = np.s_[50:70, 94:114]  # a box 4 px (5 mm) beside it
+    both = frame(np.s_[50:70, 70:90])
+    both[1][neighbour] -= 0.05
+    alone = frame(neighbour)
+    grey_both, grey_alone = ((np.full_like(image, 200), depth) for image, depth in (both, alone))  # no colour
+    assert seen_lifted(Planned, grey_both, grey_alone)  # the neighbour that stood beside it is not it
+    assert not seen_lifted(Planned, grey_both, grey_both)
     pale = frame(np.s_[50:70, 70:90], colour=(205, 200, 195))  # as light as the table: its colour tells nothing
     assert seen_lifted(Planned, pale, frame(), anywhere=True) and not seen_lifted(Planned, pale, pale, anywhere=True)

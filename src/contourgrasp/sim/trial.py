@@ -421,20 +421,29 @@ def _colour_still_there(rgb_before, after, mask, intrinsics, plane, anywhere: bo
 
 def _still_standing(depth_before, depth_after, mask, intrinsics, plane, anywhere: bool) -> bool:
     """:func:`seen_lifted`'s depth test: as many pixels of objects standing on the support, no taller than it was,
-    near its former pixels (``anywhere``: in the whole picture)."""
+    near its former pixels beyond what stood there besides it before (its neighbours) -- ``anywhere``: in the whole
+    picture."""
     with np.errstate(invalid="ignore"):
         former = heights(depth_before, intrinsics, plane)[mask]
     top = float(np.nanmax(former)) if np.isfinite(former).any() else 0.0
-    standing = np.zeros(mask.shape, dtype=bool)  # as perception finds it: no speckle
-    for candidate in perception.find_candidates(depth_after, intrinsics, plane):
-        if candidate.height < top + DETECT_RISE:
+    after = _standing(depth_after, intrinsics, plane, top + DETECT_RISE)
+    if anywhere:
+        return int(after.sum()) >= DETECT_SHARE * int(mask.sum())
+    z = float(np.nanmedian(np.where(depth_before[mask] > 0, depth_before[mask], np.nan))) if mask.any() else 1.0
+    reach = max(1, int(round(DETECT_REACH * intrinsics.fx / max(z, 1e-3))))
+    near = cv2.dilate(mask.astype(np.uint8), cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * reach + 1,) * 2)) > 0
+    besides = _standing(depth_before, intrinsics, plane, np.inf) & near & ~mask
+    return int((after & near).sum()) - int(besides.sum()) >= DETECT_SHARE * int(mask.sum())
+
+
+def _standing(depth, intrinsics, plane, below: float) -> np.ndarray:
+    """(H, W) bool: the pixels of the objects perception finds standing on ``plane`` whose top is below ``below`` (m)
+    -- candidates, so no speckle."""
+    standing = np.zeros(depth.shape[:2], dtype=bool)
+    for candidate in perception.find_candidates(depth, intrinsics, plane):
+        if candidate.height < below:
             standing |= candidate.mask
-    if not anywhere:
-        z = float(np.nanmedian(np.where(depth_before[mask] > 0, depth_before[mask], np.nan))) if mask.any() else 1.0
-        reach = max(1, int(round(DETECT_REACH * intrinsics.fx / max(z, 1e-3))))
-        standing &= cv2.dilate(mask.astype(np.uint8),
-                               cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * reach + 1,) * 2)) > 0
-    return int(standing.sum()) >= DETECT_SHARE * int(mask.sum())
+    return standing
 
 
 def trial_scene(object_spec, *, seed: int, scene_kind: str = "single", pool=(), **options) -> Scene:
