@@ -106,6 +106,9 @@ class PlannedGrasp:
         The synthesis result (None for a baseline).
     grasp_height : float or None
         The planned height of the open tips above the table (None: the execution's own rule).
+    seen : (H, W) bool or None
+        The pixels that see the object (the target candidate's), where perception chose one; a tilted
+        camera's ``segmentation`` is the object's footprint on the table instead.
     """
 
     pose: np.ndarray
@@ -116,6 +119,7 @@ class PlannedGrasp:
     camera: perception.Intrinsics
     plan: synthesis.GraspPlan | None
     grasp_height: float | None = None
+    seen: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -139,7 +143,8 @@ class SynthesisPlanner(_Planner):
         result = pipeline.plan_frame(rgb, depth, intrinsics, self.hand, self.options, target_px=target_px,
                                      memory=memory)
         return PlannedGrasp(result.plan.pose, result.T_camera_hand, result.metric.approach_depth,
-                            result.segmentation, result.metric, result.camera, result.plan, result.grasp_height)
+                            result.segmentation, result.metric, result.camera, result.plan, result.grasp_height,
+                            None if result.target is None else result.target.mask)
 
 
 @dataclass(frozen=True)
