@@ -381,7 +381,8 @@ def seen_lifted(planned, before, after, *, anywhere: bool = False) -> bool:
     out of view (:func:`_carry_away`) no longer shows the object standing where it stood.
 
     ``before`` and ``after`` are the (rgb, depth) pictures of the attempt's plan and after it. The
-    object stood on the pixels that saw it before (``planned.seen``, else ``planned.segmentation.mask``), its top ``h0`` above the
+    object stood on the pixels that saw it before (``planned.segmentation.mask``; ``planned.seen`` where that
+    is a tilted camera's footprint), its top ``h0`` above the
     support. It is still there when at least ``tolerances.DETECT_SHARE`` of those pixels show the same
     colour after (CIELAB within ``tolerances.DETECT_COLOUR``: it has not moved; a thin object depth
     does not see is told so too) -- when its colour differs from what surrounds it by at least
@@ -402,7 +403,8 @@ def seen_lifted(planned, before, after, *, anywhere: bool = False) -> bool:
     except SegmentationError:
         return False  # no table in view: nothing told
     seen = getattr(planned, "seen", None)
-    mask = np.asarray(planned.segmentation.mask if seen is None else seen, dtype=bool)
+    footprint = getattr(planned.segmentation, "on_table", False) and seen is not None
+    mask = np.asarray(seen if footprint else planned.segmentation.mask, dtype=bool)
     return not (_colour_still_there(before[0], after, mask, intrinsics, plane, anywhere)
                 or _still_standing(before[1], after[1], mask, intrinsics, plane, anywhere))
 
