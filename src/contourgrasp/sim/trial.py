@@ -289,12 +289,13 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
         if attempts == 1:
             break
         outcomes.append(bool(fields["success"]))
-        if planned is not None:
-            _carry_away(scene)
+        if planned is None:  # no plan: nothing more to try
+            detected.append(False)
+            break
+        _carry_away(scene)
         after = render(scene, sensor=sensor, seed=_noise_seed(seed, attempt, 1))
-        detected.append(planned is not None and seen_lifted(planned, (rgb, depth), after,
-                                                            anywhere=scene_kind == "single"))
-        if detected[-1] or planned is None:
+        detected.append(seen_lifted(planned, (rgb, depth), after, anywhere=scene_kind == "single"))
+        if detected[-1]:
             break
         memory = memory.with_failure(planned.metric.contour_xy, planned.pose)
         scene.set_hand(*PARKED, 0.0)  # the hand opens and leaves; what it held falls where it is
