@@ -89,13 +89,13 @@ def split_touching(candidates, rgb, depth, intrinsics: Intrinsics, plane: Plane,
     min_area_px = validation.integer("min_area_px", min_area_px, 1, error=PerceptionError)
     if colour_offset_px is not None:
         colour_offset_px = validation.pixel_offset("colour_offset_px", colour_offset_px, error=PerceptionError)
-    tried = [c for c in candidates if c.in_view and c.area_px >= 2 * min_area_px]
-    if not tried:
+    tried = [c.in_view and c.area_px >= 2 * min_area_px for c in candidates]
+    if not any(tried):
         return candidates
     h = heights(d, intrinsics, plane)
     found, split = [], False
-    for c in candidates:
-        if not any(c is t for t in tried):
+    for c, to_try in zip(candidates, tried, strict=True):
+        if not to_try:
             found.append(c)
             continue
         # each its own: the colour-depth shift varies across a frame by several pixels (parallax, misregistration)

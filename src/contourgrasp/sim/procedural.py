@@ -50,8 +50,8 @@ FAMILIES = ("box", "cylinder", "bottle", "mug", "bowl", "utensil", "tool", "smal
 #: Densities (kg/m^3) of the parts as built, where not the material's: full bottles by their outline, solid walls
 #: for mugs and bowls, thin metal or plastic utensils (a spoon, 30-60 g), a handle with a head (a hammer, 0.3 kg).
 _DENSITY = {"bottle": 900.0, "mug": 1300.0, "bowl": 1050.0, "utensil": 3000.0, "tool": 1200.0}
-_SOLID = {"cardboard": 300.0, "wood": 600.0, "tinplate": 800.0, "hard-plastic": 1050.0, "steel": 7800.0,
-          "glass": 2500.0, "rubber": 500.0, "plastic-fruit": 300.0, "stone": 2700.0}
+#: Where a material's density here is not :data:`MATERIALS`' (of a hollow moulded part's outline): solid ABS.
+_SOLID = {"hard-plastic": 1050.0}
 _NAME = re.compile(r"proc-(\d+)(?:-([a-z]+))?$")
 _SET = re.compile(r"(procedural|procedural-test):(\d+)$")
 
@@ -73,8 +73,8 @@ def procedural_object(seed: int) -> ObjectSpec:
     family = FAMILIES[int(rng.integers(len(FAMILIES)))]
     parts, material = _BUILDERS[family](rng)
     parts = _resting(parts)
-    density = _DENSITY[family] if family in _DENSITY else _SOLID[material]
     stuff = MATERIALS[material]
+    density = _DENSITY.get(family, _SOLID.get(material, stuff.density))
     mass = float(np.clip(density * sum(_volume(p) for p in parts), 0.02, 1.0))
     return ObjectSpec(f"proc-{int(seed)}-{family}", parts, mass=mass, friction_hand=stuff.friction_hand,
                       friction_table=stuff.friction_table, rgba=_shade(stuff.rgba, rng))

@@ -290,6 +290,11 @@ class Scene:
         """World position (3,) and rotation (3, 3) of the hand frame."""
         return self.data.xpos[self._palm].copy(), self.data.xmat[self._palm].reshape(3, 3).copy()
 
+    def hand_base(self) -> np.ndarray:
+        """(4,) float: the hand base's joints now (x, y, z of the hand-frame origin, world; yaw), as :meth:`set_hand`
+        takes them."""
+        return np.array(self.data.qpos[self._base_qpos], dtype=float)
+
     def set_hand(self, x: float, y: float, z: float, yaw: float, closing: float = 0.0) -> None:
         """Teleport the hand (and its servo targets): hand-frame origin at world (x, y, z), yaw about camera z."""
         target = np.array([x, y, z, yaw])

@@ -332,7 +332,7 @@ def _surroundings(lab, mask) -> np.ndarray:
 def _carry_away(scene) -> None:
     """The closed hand, at its height, carried ``CARRY_AWAY`` (m) along the world's y in ``CARRY_TIME`` s, out of the
     camera's view, with what it holds: where a robot shows the camera the table before it tries again."""
-    start = np.array(scene.data.qpos[scene._base_qpos], dtype=float)
+    start = scene.hand_base()
     steps = max(1, round(CARRY_TIME / scene.model.opt.timestep))
     for k in range(steps):
         u = (k + 1) / steps

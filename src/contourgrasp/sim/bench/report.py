@@ -344,7 +344,7 @@ def split_table(bench: Bench, results) -> list[str]:
         cells = []
         for _, members in groups:
             own = _of(results, planner, members)
-            cells.append(f"{_rate_cell(own)} {sum(r.success for r in own)}/{len(own)}")
+            cells.append(_counted_cell([r.success for r in own]))
         lines.append(_row([name, *cells]))
     return lines
 
@@ -389,7 +389,7 @@ def family_table(bench: Bench, results) -> list[str]:
         cells = []
         for p in bench.planners:
             own = _of(results, p, members[family])
-            cells.append(f"{_rate_cell(own)} {sum(r.success for r in own)}/{len(own)}")
+            cells.append(_counted_cell([r.success for r in own]))
         causes = [r.cause for r in _of(results, planner, members[family]) if r.cause is not None]
         failures = ", ".join(f"{SHORT_CAUSES[c]} {causes.count(c)}" for c in bench.causes if c in causes)
         lines.append(_row([family, len(members[family]), *cells, failures or "—"]))
@@ -412,8 +412,7 @@ def attempts_section(bench: Bench, results) -> list[str]:
             own = _of(results, planner, members)
             first = [r.outcomes[0] if r.outcomes else r.success for r in own]
             made = [max(len(r.outcomes), 1) for r in own]
-            lines.append(_row([planner, group, f"{_rate_cell_of(first)} {sum(first)}/{len(first)}",
-                               f"{_rate_cell(own)} {sum(r.success for r in own)}/{len(own)}",
+            lines.append(_row([planner, group, _counted_cell(first), _counted_cell([r.success for r in own]),
                                f"{statistics.fmean(made):.2f}" if made else "-"]))
     pairs = [(d, t) for r in results for d, t in zip(r.record.detected, r.record.outcomes)]
     told = {(d, t): sum(1 for p in pairs if p == (d, t)) for d in (True, False) for t in (True, False)}
@@ -423,6 +422,11 @@ def attempts_section(bench: Bench, results) -> list[str]:
               "", f"False success: {told[True, False]} of {len(pairs)} attempts "
               f"({100 * told[True, False] / max(len(pairs), 1):.1f} %)."]
     return lines
+
+
+def _counted_cell(successes) -> str:
+    """:func:`_rate_cell_of` and the counts: ``"50 % (15–85) 2/4"``."""
+    return f"{_rate_cell_of(successes)} {int(sum(successes))}/{len(successes)}"
 
 
 def _rate_cell_of(successes) -> str:
