@@ -545,11 +545,36 @@ def test_the_3d_plan_figure_shows_each_fingers_plane(standing_can_frame):
     assert not any("each finger's plane" in ax.get_title() for ax in image_plan_figure(flat, rgb).axes)
 
 
+def test_a_tilted_plan_carries_its_approach_into_the_pose_the_json_and_the_figure(standing_can_frame):
+    from contourgrasp.io.plan_file import image_plan_to_dict
+    from contourgrasp.visualize import image_plan_figure
+
+    rgb, depth, K = standing_can_frame
+    result = cg.plan_grasp(rgb, depth, K, cg.load_hand("five-finger-linear"), descent=True, grasp_height="auto",
+                           yaw_step=0.1, approaches="tilted")
+    assert result.approach.kind == "tilted" and result.view is not None
+    normal = result.support.plane.normal / np.linalg.norm(result.support.plane.normal)  # toward the camera
+    assert math.degrees(math.asin(-(result.T_camera_hand[:3, 2] @ normal))) == pytest.approx(45.0, abs=0.5)
+    data = image_plan_to_dict(result)
+    assert data["approach"]["kind"] == "tilted" and data["approach"]["elevation"] == pytest.approx(math.pi / 4)
+    np.testing.assert_allclose(data["approach"]["direction_camera"], result.T_camera_hand[:3, 2])
+    R = np.asarray(data["approach"]["R_camera_view"])
+    np.testing.assert_allclose(R[:, 2], result.T_camera_hand[:3, 2], atol=1e-9)
+    titles = [ax.get_title() for ax in image_plan_figure(result, rgb).axes]
+    assert any("seen tilted (elevation 45 deg" in t for t in titles)
+    top = cg.plan_grasp(rgb, depth, K, cg.load_hand("five-finger-linear"), descent=True, grasp_height="auto",
+                        yaw_step=0.1)
+    assert top.approach.kind == "top" and image_plan_to_dict(top)["approach"]["kind"] == "top"
+    assert "R_camera_view" not in image_plan_to_dict(top)["approach"]
+
+
 @pytest.mark.parametrize("options, message", [
     ({"grasp_height": "high"}, "grasp_height"), ({"grasp_height": -1.0}, "grasp_height"),
     ({"descent": "yes"}, "descent"), ({"slice_contour": 1}, "slice_contour"), ({"slice_contour": "always"}, "slice_contour"),
     ({"closing_sweep": "no"}, "closing_sweep"), ({"closing_obstacles": 1}, "closing_obstacles"), ({"small_objects": None}, "small_objects"),
-    ({"low_objects": "yes"}, "low_objects"),
+    ({"low_objects": "yes"}, "low_objects"), ({"approaches": "top+top"}, "approaches names a kind twice"),
+    ({"approaches": "front"}, "approaches must be one of"), ({"approaches": 3}, "approaches must be a string"),
+    ({"approaches": "side"}, r"approaches 'side' need descent=True and a 3-D hand"),
 ])
 def test_bad_3d_options_are_refused_by_name_even_for_a_2d_hand(standing_can_frame, options, message):
     rgb, depth, K = standing_can_frame

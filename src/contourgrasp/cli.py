@@ -172,6 +172,9 @@ def _parser() -> argparse.ArgumentParser:
                            "(default: estimated from the object's edges)")
     plan.add_argument("--approach-offset", type=_number, help="added to the nearest depth, m (default 0.01)")
     plan.add_argument("--standoff", type=_non_negative_float, help="pre-grasp distance, m (default 0.1)")
+    plan.add_argument("--approaches", metavar="KINDS",
+                      help="approach directions chosen among, kinds joined by '+': top (top-down), side "
+                           "(horizontal), tilted (45 deg), e.g. top+side (docs/approaches.md; default: the planner's)")
     plan.add_argument("--extrinsics", help="T_base_camera (4x4): .npy, .txt, .json, .yaml or autolab .tf")
     _add_synthesis_options(plan)
 
@@ -383,6 +386,7 @@ def _plan_options(args):
         "colour_offset_px": getattr(args, "colour_offset", None),
         "approach_offset": getattr(args, "approach_offset", None),
         "standoff": getattr(args, "standoff", None),
+        "approaches": getattr(args, "approaches", None),
     }
     return with_options(load_planner(args.planner).options, {k: v for k, v in given.items() if v is not None},
                         what="options", error=InputError)
@@ -411,6 +415,12 @@ def _summary(plan) -> str:
     touching = sum(not f.missed for f in plan.fingers)
     return (f"pose x={x:.4f} m y={y:.4f} m yaw={math.degrees(yaw):.1f} deg, cost {plan.cost.total:.2f}, "
             f"{touching}/{len(plan.fingers)} fingers touch, {plan.timing_ms['total']:.0f} ms")
+
+
+def _image_summary(result) -> str:
+    """:func:`_summary` of an ImageGraspPlan, naming its approach when it is not top-down."""
+    summary = _summary(result.plan)
+    return summary if result.view is None else f"{summary}, {result.approach.describe()} approach"
 
 
 def _hands(_args) -> int:
@@ -469,7 +479,7 @@ def _plan(args) -> int:
 
         return image_plan_figure(result, frame.rgb)
 
-    _write_outputs(args, image_plan_to_dict(result), figure, _summary(result.plan))
+    _write_outputs(args, image_plan_to_dict(result), figure, _image_summary(result))
     return EXIT_OK
 
 

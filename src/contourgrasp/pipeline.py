@@ -31,9 +31,10 @@ from . import perception, validation
 from . import tolerances as tol
 from .errors import HandError, NoFeasibleGrasp, PerceptionError, PlannerError, SegmentationError
 from .hand import Hand
-from .perception import HeightMap, Intrinsics, MetricContour, Plane, Segmentation
+from .perception import Approach, ApproachView, HeightMap, Intrinsics, MetricContour, Plane, Segmentation, view_along
 from .perception.camera import check_intrinsics
 from .perception.options import PerceptionOptions
+from .perception.view_along import column_points
 from .synthesis import Descent, GraspMemory, GraspPlan, search
 from .synthesis.grasp_height import grasp_height as choose_grasp_height
 from .synthesis.options import SceneOptions, SearchOptions
@@ -117,7 +118,11 @@ class ImageGraspPlan:
     grasp_height : float or None
         Height above the table of the open hand's lowest fingertip at ``T_camera_hand``, m, when
         the planner chose it (``plan_frame(descent=...)`` or ``grasp_height=...``); None when the
-        executor chooses how deep to go.
+        executor chooses how deep to go. For a side or tilted approach: the tips' distance in front of
+        the reference plane through the object's centroid (:mod:`contourgrasp.perception.view_along`).
+    view : ApproachView or None
+        Where the plan approaches other than top-down: the scene seen along its approach; ``plan`` and
+        ``grasp_height`` are then in its frame. None: top-down, in the planning frame of ``metric``.
     """
 
     plan: GraspPlan
@@ -134,11 +139,17 @@ class ImageGraspPlan:
     target_reason: str = ""
     support: perception.Support | None = None
     grasp_height: float | None = None
+    view: ApproachView | None = None
 
     @property
     def quaternion_xyzw(self) -> np.ndarray:
         """(4,) float: rotation of ``T_camera_hand`` as a unit quaternion (x, y, z, w)."""
         return Rotation.from_matrix(self.T_camera_hand[:3, :3]).as_quat()
+
+    @property
+    def approach(self) -> Approach:
+        """The direction the hand approaches along (top-down unless :attr:`view`)."""
+        return TOP_DOWN if self.view is None else self.view.approach
 
 
 def plan_frame(
@@ -192,8 +203,10 @@ def plan_frame(
         scaled.
     memory : GraspMemory, optional
         The grasps of this object that failed (:class:`~contourgrasp.synthesis.memory.GraspMemory`): no
-        pose near one, in the object's frame as it is seen now, is planned. After a failure, keep
-        ``memory.with_failure(result.metric.contour_xy, result.plan.pose)`` for the next plan.
+        pose near one, in the object's frame as it is seen now, is planned, and the approach kinds that
+        failed fewer times are tried first (:func:`approach_order`). After a failure, keep
+        ``memory.with_failure(result.metric.contour_xy, result.plan.pose, approach=result.approach.kind)``
+        for the next plan.
 
     Notes
     -----
@@ -246,17 +259,116 @@ def plan_frame(
     on_section = None
     if slicing == "unbalanced" and asked is not None:
         on_section = partial(_balanced_on_section, heights, hand, spec, asked[0], search_options, low, exclude)
-    plan = search(metric.contour_xy if section is None else section, hand, search_options, descent=spec,
-                  balanced_alternative=on_section, low_object=low, exclude=exclude)
+    kinds = approach_order(scene_options.approaches, memory)
+    if kinds != ["top"] and spec is None:
+        if not (scene_options.descent and hand.is_3d):
+            raise PlannerError(f"approaches {scene_options.approaches!r} need descent=True and a 3-D hand "
+                               f"(its file's chains): a side or tilted hand is checked against the scene in 3-D")
+        raise NoFeasibleGrasp(f"approaches {scene_options.approaches!r} need a table plane: none was found")
+    plan, view, top_down_error = None, None, None
+    for kind in kinds:  # the first kind's plan, or the first that balances the squeeze where that one does not
+        found, seen_along = None, None
+        if kind == "top":
+            try:
+                found = search(metric.contour_xy if section is None else section, hand, search_options, descent=spec,
+                               balanced_alternative=on_section, low_object=low, exclude=exclude)
+            except NoFeasibleGrasp as err:
+                top_down_error = err
+        else:
+            found, seen_along = _best_along(kind, heights, hand, scene_options, search_options)
+        if found is not None and (plan is None or found.balanced):
+            plan, view = found, seen_along
+        if plan is not None and plan.balanced:
+            break
+    if plan is None:
+        raise top_down_error if kinds == ["top"] else NoFeasibleGrasp(
+            f"no feasible grasp along any approach of {scene_options.approaches!r}"
+            + ("" if top_down_error is None else f"; top-down: {top_down_error}"))
     tip_height = None if asked is None else asked[0] if plan.descent is None else float(plan.descent.tip_height[0])
+    frame, frame_heights = (metric, heights) if view is None else (_view_metric(metric, view), view.heights)
     depth_at = (metric.approach_depth if tip_height is None
-                else palm_depth(metric, heights, hand, plan.pose, tip_height))
-    T_camera_hand = hand_pose(metric, plan.pose, depth_at)
+                else palm_depth(frame, frame_heights, hand, plan.pose, tip_height))
+    T_camera_hand = hand_pose(frame, plan.pose, depth_at)
     T_camera_pregrasp = T_camera_hand.copy()
     T_camera_pregrasp[:3, 3] -= options.standoff * T_camera_hand[:3, 2]
     T_base_hand = None if T_base_camera is None else T_base_camera @ T_camera_hand
     return ImageGraspPlan(plan, seg, metric, intrinsics, T_camera_hand, T_camera_pregrasp, T_base_hand, filled,
-                          heights, *scene, grasp_height=tip_height)
+                          heights, *scene, grasp_height=tip_height, view=view)
+
+
+#: The top-down approach: along the table's normal, into it.
+TOP_DOWN = Approach(math.pi / 2)
+
+#: Elevations (rad) of the approach kinds other than top-down.
+APPROACH_ELEVATIONS = {"side": 0.0, "tilted": math.pi / 4}
+
+
+def approach_set(approaches: str, heights: HeightMap) -> tuple[Approach, ...]:
+    """The approaches other than top-down that :attr:`SceneOptions.approaches` names (e.g. ``"top+side"``).
+
+    Per kind's elevation (:data:`APPROACH_ELEVATIONS`), four azimuths: along the target footprint's
+    principal axis, across it, and their opposites (the footprint: the map's object cells; a round one's
+    axis is any). Our reading of the thesis's "check different viewpoints": a person takes a can, a
+    bottle or a standing box from the side across or along it, not at an angle the object gives no
+    reason for.
+    """
+    elevations = [APPROACH_ELEVATIONS[k] for k in approaches.split("+") if k in APPROACH_ELEVATIONS]
+    if not elevations or not heights.object.any():
+        return ()
+    rows, cols = np.nonzero(heights.object)
+    xs, ys = heights.centres()
+    cells = np.c_[xs[cols], ys[rows]]
+    cells = cells - cells.mean(axis=0)
+    _, vectors = np.linalg.eigh(cells.T @ cells)
+    axis = math.atan2(vectors[1, 1], vectors[0, 1])
+    return tuple(Approach(e, axis + k * math.pi / 2) for e in elevations for k in range(4))
+
+
+def approach_order(approaches: str, memory: GraspMemory | None = None) -> list[str]:
+    """The approach kinds of :attr:`SceneOptions.approaches` in the order a plan tries them: as named, the kinds
+    that failed fewer times on this object (``memory``) first.
+
+    :func:`plan_frame` plans the first kind in this order with a feasible pose, unless its plan does not
+    balance the squeeze (:attr:`GraspPlan.balanced`) and a later kind's does: then that one.
+
+    >>> approach_order("top+tilted+side")
+    ['top', 'tilted', 'side']
+    """
+    kinds = approaches.split("+")
+    failed = {} if memory is None else memory.failures_by_kind()
+    return sorted(kinds, key=lambda kind: failed.get(kind, 0))
+
+
+def _best_along(kind: str, heights: HeightMap, hand: Hand, scene_options: SceneOptions,
+                search_options: SearchOptions) -> tuple[GraspPlan | None, ApproachView | None]:
+    """The lowest-cost plan along the approaches of ``kind`` (:func:`approach_set`), of those that balance the squeeze
+    where one does, and its view; (None, None) when none has a feasible pose. Each is planned on the target's cross-section at the grasp height asked
+    for in its view: the fingertips close there, and what stands in front of them is what they meet."""
+    best, best_view = None, None
+    points = column_points(heights)
+    for approach in approach_set(kind, heights):
+        try:
+            view = view_along(heights, approach, points=points)
+        except PerceptionError:  # the target hidden along it
+            continue
+        asked = choose_grasp_height(hand, view.heights, scene_options.grasp_height or "clearance")
+        section = perception.cross_section(view.heights, asked[0])
+        if section is None:
+            continue
+        spec = Descent(view.heights, *asked, sweep=scene_options.closing_sweep, closing=scene_options.closing_obstacles)
+        try:
+            plan = search(section, hand, search_options, descent=spec)
+        except NoFeasibleGrasp:
+            continue
+        if best is None or (not plan.balanced, plan.cost.total) < (not best.balanced, best.cost.total):
+            best, best_view = plan, view
+    return best, best_view
+
+
+def _view_metric(metric: MetricContour, view: ApproachView) -> MetricContour:
+    """``metric`` with the approach frame of ``view`` as its planning frame (its contour the outline seen along it)."""
+    return replace(metric, contour_xy=view.contour_xy, R_camera_plane=metric.R_camera_plane @ view.R_plane_view,
+                   origin=metric.origin + metric.R_camera_plane @ view.origin)
 
 
 #: The note of a plan made on the cross-section because no pose balanced the squeeze on the outline seen.

@@ -304,6 +304,13 @@ HEIGHT_MAP_CELL = 0.002
 #: fingers' knuckles lean 3-5 cm further), so every cell a planned pose's fingers pass over is in it.
 HEIGHT_MAP_MARGIN = 0.20
 
+#: The scene seen along a side or tilted approach (perception.view_along): a cell's side, in the height map's
+#: cells (a cell's diagonal, so that columns seen slantwise leave no gap between them; the columns are sampled as
+#: finely), and how far (m) its grid reaches beyond the target's outline and its check of the hand's way reaches
+#: in front of the target: the hand's reach.
+VIEW_CELL = 2.0 ** 0.5
+VIEW_MARGIN = 0.15
+
 #: Height map: raised cells within this distance (m) of the object's contour or mask points belong to the
 #: object too: the mask's outermost pixels and the contour through their centres stop up to a few pixels
 #: short of the object's edge (the footprint of a tilted camera misses 1-3 px on the object's far side).

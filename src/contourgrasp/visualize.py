@@ -143,8 +143,13 @@ def harmonics_figure(contour_xy, harmonics: Sequence[int] = (1, 2, 4, 8), *, cur
 
 
 def _to_pixels(result, points_xy, shift=(0, 0)) -> np.ndarray:
-    """(n, 2) float: pixels of planning-frame points (n, 2) in the contour's plane, less ``shift``."""
-    return result.camera.project(result.metric.to_camera(points_xy)) - shift
+    """(n, 2) float: pixels of planning-frame points (n, 2) in the contour's plane, less ``shift``; of a side or
+    tilted approach's frame, at the plan's grasp height (where the fingertips close)."""
+    if result.view is None:
+        return result.camera.project(result.metric.to_camera(points_xy)) - shift
+    xy = np.asarray(points_xy, dtype=float).reshape(-1, 2)
+    plane = result.view.to_plane(np.c_[xy, np.full(len(xy), -result.grasp_height)])
+    return result.camera.project(result.metric.origin + plane @ result.metric.R_camera_plane.T) - shift
 
 
 def image_plan_figure(result, rgb=None) -> Figure:
@@ -153,7 +158,10 @@ def image_plan_figure(result, rgb=None) -> Figure:
     The third panel (:func:`draw_heights`) shows ``result.height_map`` under the planned
     hand's finger paths; without a height map (no table plane) the figure has the first two only.
     With a planned grasp height and a 3-D hand a fourth (:func:`draw_side_view`) shows each finger's
-    open chain at that height over the scene's profile in the finger's own vertical plane.
+    open chain at that height over the scene's profile in the finger's own vertical plane. A side or
+    tilted approach's plan is drawn in its approach frame (the middle panels: the outline and the map
+    seen along it; "height" is then the distance toward the hand, :mod:`contourgrasp.perception.view_along`),
+    and projected into the image at its grasp height.
 
     ``result`` is a :class:`contourgrasp.pipeline.ImageGraspPlan`; ``rgb`` the
     colour image (the depth-derived mask is shown when it is None). Over a
@@ -161,7 +169,7 @@ def image_plan_figure(result, rgb=None) -> Figure:
     is drawn less the colour offset, so that it lines up with the colour.
     """
     plan = result.plan
-    heights = result.height_map
+    heights = result.height_map if result.view is None else result.view.heights
     side = heights is not None and result.grasp_height is not None and plan.hand.is_3d
     if heights is None:
         fig = Figure(figsize=(16, 7), layout="constrained")
@@ -197,21 +205,29 @@ def image_plan_figure(result, rgb=None) -> Figure:
     draw_plan(plan_ax, plan)
     _finish_axes(plan_ax)
     x, y, yaw = plan.pose
-    plan_ax.set_title(f"{plan.hand.name} in the {result.metric.frame} plane: x={x:.3f} m, y={y:.3f} m, "
+    where = f"in the {result.metric.frame} plane" if result.view is None else f"seen {result.approach.describe()}"
+    plan_ax.set_title(f"{plan.hand.name} {where}: x={x:.3f} m, y={y:.3f} m, "
                       f"yaw={math.degrees(yaw):.0f}°, cost {plan.cost.total:.1f}", fontsize=10)
     plan_ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    along = result.view is not None
     if heights is not None:
-        draw_heights(height_ax, heights, plan, fig)
+        draw_heights(height_ax, heights, plan, fig, along=along)
     if side:
-        draw_side_view(side_ax, heights, plan, result.grasp_height)
+        draw_side_view(side_ax, heights, plan, result.grasp_height, along=along)
     return fig
 
 
-def draw_side_view(ax, heights, plan: GraspPlan, grasp_height: float) -> None:
+#: Axis words of a map in the planning frame and in an approach frame (:mod:`contourgrasp.perception.view_along`).
+HEIGHT_WORDS = {False: ("planning frame", "height above the table"),
+                True: ("approach frame", "toward the hand from the reference plane")}
+
+
+def draw_side_view(ax, heights, plan: GraspPlan, grasp_height: float, *, along: bool = False) -> None:
     """Each finger's body at the grasp height beside the scene, in the vertical plane the finger closes in.
 
     Horizontal: distance from the finger's knuckle along its chain's plane (:func:`~contourgrasp.hand.chain_plane`,
-    toward the object); vertical: height above the table. Per finger, in its colour: the height map's profile along that
+    toward the object); vertical: height above the table (``along``: an approach frame's, toward the hand from
+    its reference plane). Per finger, in its colour: the height map's profile along that
     line (filled; unseen cells at their conservative bound, dotted) and its open chain's links.
     """
     hand = plan.hand
@@ -233,8 +249,10 @@ def draw_side_view(ax, heights, plan: GraspPlan, grasp_height: float) -> None:
     ax.axhline(palm_height, color="0.2", lw=2, label="palm underside")
     ax.axhline(grasp_height, color="tab:blue", ls=":", lw=1, label=f"grasp height {1e3 * grasp_height:.0f} mm")
     ax.set_aspect("equal")
+    if along:  # the table, blocked along a horizontal approach, stands at BLOCKED: show the hand's reach
+        ax.set_ylim(-0.01, 1.5 * palm_height)
     ax.set_xlabel("m along each finger's plane, from its knuckle")
-    ax.set_ylabel("height above the table [m]")
+    ax.set_ylabel(f"{HEIGHT_WORDS[along][1]} [m]")
     least = "" if plan.descent is None else (f", least clearance {1e3 * float(plan.descent.clearance[0].min()):.1f} mm "
                                               f"({plan.descent.bodies[int(np.argmin(plan.descent.clearance[0]))]})")
     ax.set_title(f"each finger's plane at the grasp{least}", fontsize=10)
@@ -243,9 +261,10 @@ def draw_side_view(ax, heights, plan: GraspPlan, grasp_height: float) -> None:
     ax.legend(unique.values(), unique.keys(), loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
 
 
-def draw_heights(ax, heights, plan: GraspPlan | None = None, fig: Figure | None = None) -> None:
+def draw_heights(ax, heights, plan: GraspPlan | None = None, fig: Figure | None = None, *, along: bool = False) -> None:
     """Draw a :class:`~contourgrasp.perception.HeightMap` on ``ax``, height-coloured, unseen cells grey.
 
+    ``along``: the map is an approach frame's (its axes so labelled).
     With ``plan`` (planned in the same planning frame) the contour, the finger paths and the
     starts are drawn over it and the view is cropped to them; ``fig`` adds a colour bar.
     """
@@ -255,7 +274,7 @@ def draw_heights(ax, heights, plan: GraspPlan | None = None, fig: Figure | None 
     image = ax.imshow(1e3 * heights.heights, extent=(x0, x1, y1, y0), origin="upper", cmap=cmap, vmin=0.0,
                       vmax=1e3 * top, interpolation="nearest")
     if fig is not None:
-        fig.colorbar(image, ax=ax, shrink=0.8, label="height above the table [mm] (grey: unseen)")
+        fig.colorbar(image, ax=ax, shrink=0.8, label=f"{HEIGHT_WORDS[along][1]} [mm] (grey: unseen)")
     if plan is not None:
         ax.plot(*np.vstack([plan.contour, plan.contour[:1]]).T, color="white", lw=1, label="contour")
         points = [plan.contour]
@@ -269,7 +288,7 @@ def draw_heights(ax, heights, plan: GraspPlan | None = None, fig: Figure | None 
         ax.set_xlim(max(lo[0], x0), min(hi[0], x1))
         ax.set_ylim(min(hi[1], y1), max(lo[1], y0))
     ax.set_aspect("equal")
-    ax.set_xlabel("x [m] (planning frame)")
+    ax.set_xlabel(f"x [m] ({HEIGHT_WORDS[along][0]})")
     ax.set_ylabel("y [m]")
     obstacles = f", obstacles up to {1e3 * heights.obstacle_max_height:.0f} mm" if heights.obstacles.any() else ""
     ax.set_title(f"height map ({1e3 * heights.cell:g} mm cells): object up to "

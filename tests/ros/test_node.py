@@ -265,7 +265,8 @@ def test_a_frame_stamped_far_ahead_does_not_freeze_the_plan_on_it(ros):
 @pytest.mark.parametrize("name, value", [("segment", "bogus"), ("hand", "no-such-hand"), ("standoff", -0.1),
                                          ("pair_tolerance", 0.0), ("top_k", 0), ("standoff", 1),
                                          ("harmonics", 100000), ("xy_step", 1e-9), ("yaw_step_deg", 1e-6),
-                                         ("target", [1, 2, 3]), ("target", "centre")])
+                                         ("target", [1, 2, 3]), ("target", "centre"), ("approaches", "sideways"),
+                                         ("approaches", "top+top")])
 def test_an_invalid_parameter_is_refused_at_start_naming_it(ros, name, value):
     context, _ = ros
     with pytest.raises(InputError, match=f"^parameter {name}: "):
@@ -431,6 +432,14 @@ def test_parameters_that_fit_alone_but_not_together_are_refused_naming_them():
     with pytest.raises(InputError, match=r"^parameters .*xy_step, yaw_step_deg together: the search grid would have"):
         settings_from_parameters({"planner": "paper", "xy_step": 0.005, "yaw_step_deg": 1.0})
     assert settings_from_parameters({"planner": "paper", "xy_step": 0.005}).options.search.grid.xy_step == 0.005
+
+
+def test_side_approaches_need_a_planner_that_checks_the_descent():
+    from contourgrasp.ros.node import settings_from_parameters
+
+    with pytest.raises(InputError, match=r"^parameter approaches: side and tilted approaches need a planner with descent"):
+        settings_from_parameters({"planner": "paper", "approaches": "top+tilted"})
+    assert settings_from_parameters({"approaches": "top+tilted"}).options.scene.approaches == "top+tilted"
 
 
 def _call(camera, kind, service, request):

@@ -11,6 +11,7 @@ from contourgrasp.sim import (SENSORS, Camera, build_scene, hand_pose_from_matri
 from contourgrasp.sim.objects import flat_tool
 from contourgrasp.sim.planners import make_planner
 from contourgrasp.sim import ROBOT_ARM
+from contourgrasp.sim.objects import ObjectSpec, Part
 from contourgrasp.sim.scene import R_WORLD_CAMERA, Workspace
 
 TILT = np.radians(12.7)
@@ -179,3 +180,30 @@ def test_a_robot_arm_in_view_enters_from_the_border_touches_nothing_and_is_not_p
     assert (masks[0] & masks[1]).sum() > 0.99 * (masks[0] | masks[1]).sum()  # the support's fit sees the arm's edge
     np.testing.assert_allclose(plans[0].T_camera_hand[:3, 3], plans[1].T_camera_hand[:3, 3], atol=0.002)
     np.testing.assert_allclose(plans[0].T_camera_hand[:3, :3], plans[1].T_camera_hand[:3, :3], atol=0.03)
+
+
+def test_the_base_angles_turn_the_hand_to_any_rotation():
+    from scipy.spatial.transform import Rotation
+
+    from contourgrasp.sim.scene import base_angles
+
+    def turned(yaw, tilt, roll):
+        return (Rotation.from_euler("z", -yaw) * Rotation.from_euler("y", tilt) * Rotation.from_euler("z", -roll)
+                * Rotation.from_euler("x", np.pi)).as_matrix()
+
+    for R in Rotation.random(50, random_state=3).as_matrix():
+        np.testing.assert_allclose(turned(*base_angles(R)), R, atol=1e-9)
+    yaw, tilt, roll = base_angles(turned(0.7, 0.0, 0.0))  # facing down: all the turn is yaw
+    assert (yaw, tilt, roll) == (pytest.approx(0.7), 0.0, 0.0)
+
+
+def test_the_scene_is_photographed_at_rest():
+    """An object whose resting face is an unstable stand falls before the picture: a moment later it lies still."""
+    plank = Part("box", (0.004, 0.04, 0.06), pos=(0.0, 0.0, 0.06))  # 8 mm x 8 cm x 12 cm, on end
+    arm = Part("box", (0.03, 0.01, 0.01), pos=(0.03, 0.0, 0.11))  # its top heavy to one side: it falls
+    standing = ObjectSpec("plank", (plank, arm), mass=0.1, friction_hand=0.6, friction_table=0.5)
+    scene = build_scene(standing, seed=1)
+    before = scene.object_com()
+    scene.step(0.5)
+    assert np.linalg.norm(scene.object_com() - before) < 0.003
+    assert before[2] < 0.045  # fallen: its centre of mass stood 6.5 cm up

@@ -8,10 +8,12 @@ import pytest
 
 from contourgrasp import InputError, NoFeasibleGrasp, load_hand
 from contourgrasp.errors import SimulationError
-from contourgrasp.sim import (FAILURE_CAUSES, Camera, ObjectSpec, Part, Workspace, build_scene, execute_grasp,
+from contourgrasp.sim import (FAILURE_CAUSES, Camera, ObjectSpec, Part, Workspace, build_scene, execute_grasp, render,
                               pose_matrix, run_trial)
 from contourgrasp.sim.planners import make_planner
-from contourgrasp.sim.trial import MISSED, NO_PLAN, STRUCK, scripted_grasp
+from contourgrasp.sim.scene import R_WORLD_CAMERA
+from contourgrasp.sim.tendon_hand import HandDesign
+from contourgrasp.sim.trial import MISSED, NO_PLAN, STRUCK, Execution, scripted_grasp
 
 PAPER = make_planner("paper", load_hand("five-finger-linear"))
 
@@ -90,8 +92,50 @@ def test_same_seed_same_record():
 def test_pose_must_face_the_table():
     scene = build_scene("can", seed=0)
     flipped = np.diag([1.0, -1.0, -1.0, 1.0])
-    with pytest.raises(InputError, match="camera's z"):
+    with pytest.raises(InputError, match="faces away from the table: its z axis .* points up 90 deg"):
         execute_grasp(scene, flipped, 0.6)
+
+
+@pytest.mark.parametrize("elevation_deg, azimuth_deg, roll_deg", [(0.0, 30.0, 0.0), (45.0, 200.0, 70.0),
+                                                                   (20.0, -100.0, -40.0)])
+def test_a_side_or_tilted_approach_travels_along_its_axis_to_the_pose(elevation_deg, azimuth_deg, roll_deg):
+    """Far from the can, the open hand comes along its approach axis, stops at the pose, closes on air."""
+    scene = build_scene("can", seed=0, design=HandDesign(wrist=True))
+    e, a, r = (math.radians(v) for v in (elevation_deg, azimuth_deg, roll_deg))
+    approach = np.array([math.cos(e) * math.cos(a), math.cos(e) * math.sin(a), -math.sin(e)])  # world
+    side = np.cross(approach, [0.0, 0.0, 1.0])
+    side /= np.linalg.norm(side)
+    x = math.cos(r) * side + math.sin(r) * np.cross(approach, side)
+    R_world_hand = np.column_stack([x, np.cross(approach, x), approach])
+    position = np.array([0.25, 0.3, 0.25])  # the can stands near the origin: nothing in the way
+    T = np.eye(4)
+    T[:3, :3], T[:3, 3] = R_WORLD_CAMERA.T @ R_world_hand, scene.camera.from_world(position)
+    outcome = execute_grasp(scene, T, 0.0)
+    assert outcome.cause == MISSED and outcome.first_contact == ()
+    palm, R = scene.palm_pose()
+    np.testing.assert_allclose(palm, position + [0.0, 0.0, Execution().lift_height], atol=2e-3)  # closed, lifted
+    np.testing.assert_allclose(R, R_world_hand, atol=0.02)
+
+
+def test_a_hand_without_a_wrist_refuses_a_side_approach_naming_the_wrist():
+    scene = build_scene("can", seed=0)
+    T = np.eye(4)
+    T[:3, :3] = R_WORLD_CAMERA.T @ np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])  # along world x
+    T[:3, 3] = scene.camera.from_world([0.3, 0.3, 0.2])
+    with pytest.raises(SimulationError, match="no wrist to tilt or roll: build the scene with HandDesign"):
+        execute_grasp(scene, T, 0.0)
+
+
+def test_a_trial_of_a_planner_with_side_approaches_gets_a_wrist_and_a_top_down_one_does_not():
+    from contourgrasp.sim.trial import with_wrist
+
+    hand = load_hand("five-finger-linear")
+    planner = make_planner("default", hand)
+    assert with_wrist(planner, hand, HandDesign()) == (hand, HandDesign())
+    sided = replace(planner, options=replace(planner.options, scene=replace(planner.options.scene,
+                                                                            approaches="top+tilted")))
+    assert with_wrist(sided, hand, HandDesign())[1].wrist
+    assert with_wrist(lambda *a: None, hand, HandDesign())[1] == HandDesign()
 
 
 def test_a_planned_grasp_height_is_executed():
@@ -184,3 +228,22 @@ def test_a_picture_says_lifted_when_the_object_has_left_its_place_and_not_when_i
     assert not seen_lifted(Planned, grey_both, grey_both)
     pale = frame(np.s_[50:70, 70:90], colour=(205, 200, 195))  # as light as the table: its colour tells nothing
     assert seen_lifted(Planned, pale, frame(), anywhere=True) and not seen_lifted(Planned, pale, pale, anywhere=True)
+
+
+@pytest.mark.parametrize("approaches, elevation_deg", [("side", 0.0), ("tilted", 45.0)])
+def test_a_standing_can_planned_from_the_side_or_tilted_is_lifted(approaches, elevation_deg):
+    """The plan approaches along the kind asked for (its angle below the table measured from its pose), and lifts."""
+    from contourgrasp.sim.objects import soda_can
+
+    hand = load_hand("five-finger-linear")
+    planner = make_planner("default", hand)
+    planner = replace(planner, options=replace(planner.options, scene=replace(planner.options.scene,
+                                                                              approaches=approaches)))
+    scene = build_scene(soda_can(standing=True), seed=2, hand=hand, design=HandDesign(wrist=True))
+    rgb, depth = render(scene, sensor="basic", seed=2)
+    planned = planner.plan(rgb, depth, scene.camera.intrinsics)
+    assert planned.approach == approaches
+    approach_world = R_WORLD_CAMERA @ planned.T_camera_hand[:3, 2]
+    assert math.degrees(math.asin(-approach_world[2])) == pytest.approx(elevation_deg, abs=1.0)
+    outcome = execute_grasp(scene, planned.T_camera_hand, planned.approach_depth, grasp_height=planned.grasp_height)
+    assert outcome.success, outcome

@@ -95,3 +95,43 @@ def test_the_next_plan_of_the_bundled_frame_avoids_the_failed_one():
     assert np.hypot(*step[:2]) > tol.MEMORY_REACH or turn > tol.MEMORY_TURN
     with pytest.raises(PlannerError, match="memory must be"):
         cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, yaw_step=0.1, memory=[first.plan.pose])
+
+
+def test_a_failure_from_the_side_is_kept_as_its_kind_only():
+    square = np.array([[0.0, 0.0], [0.04, 0.0], [0.04, 0.02], [0.0, 0.02]])
+    memory = GraspMemory().with_failure(square, (0.02, 0.05, 0.0)).with_failure(square, (0.0, 0.0, 1.0),
+                                                                                approach="tilted")
+    assert len(memory) == 2 and len(memory.failures) == 1
+    assert memory.failures_by_kind() == {"top": 1, "tilted": 1}
+    assert memory.excluded(square, [[0.02, 0.05, 0.0], [0.0, 0.0, 1.0]]).tolist() == [True, False]
+
+
+def test_the_memory_keeps_the_last_failures_of_every_kind_in_order():
+    from contourgrasp.tolerances import MAX_MEMORY_FAILURES
+
+    square = np.array([[0.0, 0.0], [0.04, 0.0], [0.04, 0.02], [0.0, 0.02]])
+    memory = GraspMemory()
+    for k in range(MAX_MEMORY_FAILURES + 3):
+        memory = memory.with_failure(square, (0.01 * k, 0.0, 0.0), approach="side" if k % 3 == 0 else "top")
+    assert len(memory) == MAX_MEMORY_FAILURES
+    assert len(memory.failures) == memory.kinds.count("top")
+    assert memory.failures[-1][0] == pytest.approx(0.01 * (MAX_MEMORY_FAILURES + 2) - 0.02, abs=1e-6)  # the last one kept
+
+
+@pytest.mark.parametrize("approach", ["from above", "", None, "TOP"])
+def test_an_unknown_approach_kind_is_refused(approach):
+    square = np.array([[0.0, 0.0], [0.04, 0.0], [0.04, 0.02], [0.0, 0.02]])
+    with pytest.raises(PlannerError, match="approach"):
+        GraspMemory().with_failure(square, (0.0, 0.0, 0.0), approach=approach)
+
+
+def test_the_kinds_that_failed_fewer_times_are_tried_first():
+    from contourgrasp.pipeline import approach_order
+
+    square = np.array([[0.0, 0.0], [0.04, 0.0], [0.04, 0.02], [0.0, 0.02]])
+    assert approach_order("top+tilted+side") == ["top", "tilted", "side"]
+    once = GraspMemory().with_failure(square, (0.0, 0.0, 0.0))
+    assert approach_order("top+tilted+side", once) == ["tilted", "side", "top"]
+    twice = once.with_failure(square, (0.0, 0.0, 0.0), approach="tilted")
+    assert approach_order("top+tilted+side", twice) == ["side", "top", "tilted"]
+    assert approach_order("top", twice) == ["top"]

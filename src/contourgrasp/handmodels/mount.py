@@ -21,7 +21,7 @@ from functools import cached_property
 
 import numpy as np
 
-from ..sim.tendon_hand import BASE_XML, HAND_BIT, TABLE_BIT, HandDesign, base_servos_xml
+from ..sim.tendon_hand import HAND_BIT, TABLE_BIT, HandDesign, base_servos_xml, base_xml
 from .derive import Derivation, derive_hand, model_spec
 from .lookup import load_model
 from ..sim.scene import mujoco
@@ -94,7 +94,8 @@ class MountedHand:
 
     def body_xml(self) -> str:
         """The base and an empty ``palm`` body (the hand frame), which :meth:`mount` fills."""
-        return "\n".join([*BASE_XML, '    <site name="hand_origin" pos="0 0 0" size="0.004"/>', "  </body>", "</body>"])
+        return "\n".join([*base_xml(self.design), '    <site name="hand_origin" pos="0 0 0" size="0.004"/>', "  </body>",
+                          "</body>"])
 
     def tendon_xml(self) -> str:
         return ""

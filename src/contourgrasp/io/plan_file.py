@@ -161,6 +161,21 @@ def support_to_dict(support) -> dict | None:
     }
 
 
+def approach_to_dict(result) -> dict:
+    """The approach of an ImageGraspPlan: its name, elevation and azimuth (rad, in the planning frame), its direction
+    in the camera frame, and for a side or tilted approach the approach frame's rotation and origin in the camera
+    frame (``pose`` and ``grasp_height`` are then in that frame)."""
+    approach = result.approach
+    data = {"kind": approach.kind, "description": approach.describe(),
+            "elevation": approach.elevation, "azimuth": approach.azimuth,
+            "direction_camera": result.T_camera_hand[:3, 2].tolist()}
+    if result.view is not None:
+        metric, view = result.metric, result.view
+        data["R_camera_view"] = (metric.R_camera_plane @ view.R_plane_view).tolist()
+        data["origin_camera"] = (metric.origin + metric.R_camera_plane @ view.origin).tolist()
+    return data
+
+
 def image_plan_to_dict(result) -> dict:
     """``plan_to_dict`` of the planar plan plus the camera, segmentation and 6-DoF poses of an ImageGraspPlan."""
     data = plan_to_dict(result.plan)
@@ -188,6 +203,7 @@ def image_plan_to_dict(result) -> dict:
     data["objects"] = [candidate_to_dict(c) for c in result.candidates]
     data["target"] = {"label": None if result.target is None else result.target.label, "reason": result.target_reason}
     data["approach_depth"] = metric.approach_depth
+    data["approach"] = approach_to_dict(result)
     data["height_map"] = height_map_summary(result.height_map)
     data["grasp_height"] = result.grasp_height
     data["T_camera_hand"] = result.T_camera_hand.tolist()

@@ -36,6 +36,7 @@ which is the thesis's setting)::
     closing_obstacles = false    # refuse poses where a closing finger runs into a neighbour or a bin wall
     small_objects = false        # fewer touching fingers where no pose satisfies the constraints (synthesis.search)
     low_objects = false          # an object lower than tolerances.LOW_OBJECT_HEIGHT planned first as a pinch (plan_frame)
+    approaches = "top"           # approach kinds chosen among, joined by "+": top, side, tilted (pipeline.approach_set)
 
 Unknown keys, wrong types and impossible values are refused with
 :class:`PlannerFileError` naming the file and the field; so is a file that is not UTF-8 text or
@@ -94,6 +95,7 @@ class _PlannerSchema(BaseModel):
     closing_obstacles: bool | None = None
     small_objects: bool | None = None
     low_objects: bool | None = None
+    approaches: str | None = None
     grasp_height: (Literal["clearance", "auto"]
                    | Annotated[float, Field(ge=0, le=tol.MAX_HAND_SIZE, allow_inf_nan=False)] | None) = None
 

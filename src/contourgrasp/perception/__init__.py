@@ -27,6 +27,8 @@ One module per stage, in the order the pipeline runs them:
   frame, the object's cells marked (:class:`HeightMap`)
 * :mod:`~contourgrasp.perception.cross_section` -- the object's outline at a height, from the height
   map (:func:`cross_section`)
+* :mod:`~contourgrasp.perception.view_along` -- the scene seen along a side or tilted approach: the
+  target's outline and a height map in the approach's frame (:func:`view_along`)
 * :mod:`~contourgrasp.perception.options` -- how a frame is read (:class:`PerceptionOptions`)
 
 Conventions: see :mod:`~contourgrasp.perception.camera`. The thresholds are in
@@ -52,11 +54,12 @@ from .segmentation import SEGMENT_METHODS, SegmentMethod, segment, segment_from_
 from .support import Support, find_support
 from .table import Plane, fit_plane, fit_table_plane
 from .touching import split_touching
+from .view_along import Approach, ApproachView, view_along
 
 __all__ = [
-    "Candidate", "DEPTH_MODES", "DepthMode", "HeightMap", "Intrinsics", "MetricContour", "PerceptionError", "PerceptionOptions", "PerceptionWarning", "Plane",
+    "Approach", "ApproachView", "Candidate", "DEPTH_MODES", "DepthMode", "HeightMap", "Intrinsics", "MetricContour", "PerceptionError", "PerceptionOptions", "PerceptionWarning", "Plane",
     "SEGMENT_METHODS", "SegmentMethod", "Segmentation", "SegmentationError", "Support", "TARGET_RULES", "add_flat_parts", "approach_depth",
     "as_depth", "backproject", "choose_target", "colour_on_depth", "colour_offset", "contour_to_metric", "denoised_depth", "fill_depth_holes",
     "cross_section", "find_candidates", "find_support", "fit_plane", "fit_table_plane", "hand_opening", "height_map", "hidden_side", "low_part_candidate", "mask_contour", "object_footprint", "one_frame", "open_table_holes", "register_colour", "segment",
-    "segment_depth", "segment_from_mask", "segment_rgb", "split_touching", "valid_depth",
+    "segment_depth", "segment_from_mask", "segment_rgb", "split_touching", "valid_depth", "view_along",
 ]

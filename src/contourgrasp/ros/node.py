@@ -77,6 +77,7 @@ PARAMETERS = {
     "xy_step": (0.0, "grid step in x and y, m; 0: the planner's"),
     "yaw_step_deg": (0.0, "grid step in yaw, degrees; 0: the planner's"),
     "depth_mode": ("", "contour plane: max or plane; empty: the planner's"),
+    "approaches": ("", "approach kinds chosen among, joined by '+': top, side, tilted; empty: the planner's"),
     "top_k": (DEFAULTS.search.top_k, "ranked distinct poses in the plan JSON"),
     "target": ([-1, -1], "pixel [u, v] of the depth image: plan on the object under it; [-1, -1]: the default rule"),
 }
@@ -111,7 +112,7 @@ def settings_from_parameters(values: dict) -> Settings:
              "must be a positive time in s", v)
     _require(v["harmonics"] >= 0, "harmonics", "must be an integer >= 0 (0: the planner's)", v)
     overrides = {"harmonics": v["harmonics"], "xy_step": v["xy_step"], "yaw_step": math.radians(v["yaw_step_deg"]),
-                 "depth_mode": v["depth_mode"]}
+                 "depth_mode": v["depth_mode"], "approaches": v["approaches"]}
     given = {"segment": v["segment"], "approach_offset": v["approach_offset"], "standoff": v["standoff"],
              "top_k": v["top_k"]} | {name: value for name, value in overrides.items() if value}
     for name, value in given.items():  # one at a time, so that the message names the parameter refused
@@ -124,6 +125,8 @@ def settings_from_parameters(values: dict) -> Settings:
         options = with_options(planner.options, given, what="parameters", error=InputError)
     except InputError as err:  # each one fits, not all of them together (a grid too large)
         raise InputError(f"parameters {', '.join(PARAMETER_OF.get(n, n) for n in given)} together: {err}") from None
+    _require(options.scene.approaches == "top" or (options.scene.descent and hand.is_3d), "approaches",
+             "side and tilted approaches need a planner with descent and a 3-D hand", v)
     return Settings(hand, planner, v["pair_tolerance"], v["continuous"], options, target_pixel(v["target"]))
 
 
@@ -267,7 +270,8 @@ class ContourGraspNode(Node):
             self.memory, self.last = GraspMemory(), None
             response.success, response.message = True, "the grasp succeeded: the memory of failed grasps is cleared"
         else:
-            self.memory = self.memory.with_failure(self.last.metric.contour_xy, self.last.plan.pose)
+            self.memory = self.memory.with_failure(self.last.metric.contour_xy, self.last.plan.pose,
+                                                   approach=self.last.approach.kind)
             self.last = None  # reported once
             response.success, response.message = True, (
                 f"the grasp failed: remembered; the next plans avoid the {len(self.memory)} failed grasp(s)")

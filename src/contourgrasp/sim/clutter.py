@@ -217,7 +217,8 @@ def build_clutter(obj, pool, *, kind: str, seed: int, hand: Hand | str = "five-f
         As :func:`~contourgrasp.sim.scene.build_scene`; ``camera`` is the top-down
         reference the grasp is executed in, and its height the tilted camera's distance.
     settle : float
-        Seconds the objects settle before anything looks at them.
+        Seconds the objects settle before anything looks at them, and longer while they still move
+        (:meth:`~contourgrasp.sim.scene.Scene.settle`).
     robot : bool
         A robot arm in view (:data:`~contourgrasp.sim.scene.ROBOT_ARM`).
     """
@@ -232,7 +233,7 @@ def build_clutter(obj, pool, *, kind: str, seed: int, hand: Hand | str = "five-f
                   neighbours=tuple(o for o, _ in layout.neighbours), bin=layout.bin,
                   view=tilted_view(layout.tilt, camera.height))
     scene.set_hand(0.0, 0.0, PARK_HEIGHT, 0.0)
-    scene.step(settle)
+    scene.settle(settle)
     return scene
 
 

@@ -109,6 +109,8 @@ class PlannedGrasp:
     seen : (H, W) bool or None
         The pixels that see the object (the target candidate's), where perception chose one; a tilted
         camera's ``segmentation`` is the object's footprint on the table instead.
+    approach : str
+        The plan's kind of approach: "top", "side" or "tilted" (:attr:`contourgrasp.perception.Approach.kind`).
     """
 
     pose: np.ndarray
@@ -120,6 +122,7 @@ class PlannedGrasp:
     plan: synthesis.GraspPlan | None
     grasp_height: float | None = None
     seen: np.ndarray | None = None
+    approach: str = "top"
 
 
 @dataclass(frozen=True)
@@ -144,7 +147,7 @@ class SynthesisPlanner(_Planner):
                                      memory=memory)
         return PlannedGrasp(result.plan.pose, result.T_camera_hand, result.metric.approach_depth,
                             result.segmentation, result.metric, result.camera, result.plan, result.grasp_height,
-                            None if result.target is None else result.target.mask)
+                            None if result.target is None else result.target.mask, result.approach.kind)
 
 
 @dataclass(frozen=True)

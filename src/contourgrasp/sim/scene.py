@@ -10,7 +10,10 @@ the table has depth ``height``.
 
 The object is placed with its resting face down at a random position inside
 :class:`Workspace` and a random yaw (both from the seed), then left to settle
-for :data:`SETTLE_TIME` before anything looks at it.
+for :data:`SETTLE_TIME`, and longer while anything still moves (:meth:`Scene.settle`),
+before anything looks at it: an object whose resting face is an unstable stand (the YCB
+Windex bottle's, with its mesh's uniform density) falls over first, and the
+picture shows it where it lies.
 
 A scene may also hold neighbours (bodies ``neighbour_0``, ...) and a
 :class:`Bin`, whose floor's top is then the plane z = 0 and the table that much
@@ -43,6 +46,7 @@ figures, and the bench before and after: ``docs/bench.md``, "The friction's cree
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 from dataclasses import dataclass
 
@@ -51,17 +55,24 @@ import numpy as np
 os.environ.setdefault("MUJOCO_GL", "disable")  # we only ray-cast; never load an OpenGL backend
 import mujoco  # noqa: E402
 
+from ..errors import SimulationError  # noqa: E402
 from ..hand import Hand  # noqa: E402
 from ..perception import Intrinsics  # noqa: E402
 from ..io.hand_file import load_hand  # noqa: E402
 from ..tolerances import NEIGHBOUR_LIFT, SENSOR_RANGE  # noqa: E402
-from .tendon_hand import HAND_BIT, TABLE_BIT, HandDesign, HandModel, build_hand  # noqa: E402
+from .tendon_hand import BASE_JOINTS, HAND_BIT, TABLE_BIT, WRIST_JOINTS, HandDesign, HandModel, build_hand  # noqa: E402
 from .objects import ObjectSpec, Part, object_spec  # noqa: E402
 
 #: Simulation step, s.
 TIMESTEP = 0.002
 #: Time the object is left to settle on the table before the picture, s.
 SETTLE_TIME = 0.4
+#: A scene is at rest when nothing in it moves faster than ``REST_SPEED`` (m/s; a turn at ``REST_RADIUS`` m from
+#: the body's origin); it is checked every ``REST_CHECK`` s and settles for at most ``MAX_SETTLE_TIME`` s.
+REST_SPEED = 0.01
+REST_RADIUS = 0.1
+REST_CHECK = 0.1
+MAX_SETTLE_TIME = 3.0
 #: Height of the parked hand, far above the camera (m).
 PARK_HEIGHT = 2.0
 #: Ratio of the friction constraints' impedance to the normal's (elliptic cones): how little a hold creeps
@@ -224,9 +235,10 @@ class Scene:
         self._neighbour_bodies = np.array([model.body(f"neighbour_{k}").id for k in range(len(self.neighbours))],
                                           dtype=int)
         self._palm = model.body("palm").id
-        self._base_qpos = np.array([model.joint(j).qposadr[0] for j in BASE_JOINTS])
-        self._base_ctrl = np.array([model.actuator(j).id for j in BASE_JOINTS])
-        self._base_dofs = np.array([model.joint(j).dofadr[0] for j in BASE_JOINTS])
+        joints = BASE_JOINTS + (WRIST_JOINTS if hand.design.wrist else ())
+        self._base_qpos = np.array([model.joint(j).qposadr[0] for j in joints])
+        self._base_ctrl = np.array([model.actuator(j).id for j in joints])
+        self._base_dofs = np.array([model.joint(j).dofadr[0] for j in joints])
         synergy = getattr(hand, "synergy", None)  # a mounted hand model (handmodels.mount) closes many actuators
         self._closing = synergy(model) if synergy else (np.array([model.actuator("flexion").id]), np.zeros(1),
                                                         np.ones(1))
@@ -291,13 +303,15 @@ class Scene:
         return self.data.xpos[self._palm].copy(), self.data.xmat[self._palm].reshape(3, 3).copy()
 
     def hand_base(self) -> np.ndarray:
-        """(4,) float: the hand base's joints now (x, y, z of the hand-frame origin, world; yaw), as :meth:`set_hand`
-        takes them."""
+        """(4,) or (6,) float: the hand base's joints now (x, y, z of the hand-frame origin, world; yaw; with a wrist
+        tilt and roll), as :meth:`command` takes them."""
         return np.array(self.data.qpos[self._base_qpos], dtype=float)
 
-    def set_hand(self, x: float, y: float, z: float, yaw: float, closing: float = 0.0) -> None:
-        """Teleport the hand (and its servo targets): hand-frame origin at world (x, y, z), yaw about camera z."""
-        target = np.array([x, y, z, yaw])
+    def set_hand(self, x: float, y: float, z: float, yaw: float, closing: float = 0.0, *, tilt: float = 0.0,
+                 roll: float = 0.0) -> None:
+        """Teleport the hand (and its servo targets): hand-frame origin at world (x, y, z), yaw about camera z,
+        tilt and roll as :func:`base_angles` gives them (0: palm facing down)."""
+        target = self._base_target([x, y, z, yaw, tilt, roll])
         self.data.qpos[self._base_qpos] = target
         self.data.qvel[self._base_dofs] = 0.0
         self.command(target, closing)
@@ -305,11 +319,22 @@ class Scene:
             mujoco.mj_forward(self.model, self.data)
 
     def command(self, base_target, closing: float) -> None:
-        """Servo targets for the hand base (x, y, z, yaw) and the closing (the tendon force fraction, or a mounted
-        hand model's synergy: 0 open, 1 closed)."""
-        self.data.ctrl[self._base_ctrl] = base_target
+        """Servo targets for the hand base (x, y, z, yaw, and tilt, roll: 0 when left out) and the closing (the
+        tendon force fraction, or a mounted hand model's synergy: 0 open, 1 closed)."""
+        self.data.ctrl[self._base_ctrl] = self._base_target(base_target)
         actuators, open_, closed = self._closing
         self.data.ctrl[actuators] = open_ + closing * (closed - open_)
+
+    def _base_target(self, base_target) -> np.ndarray:
+        """The base joints' values of (x, y, z, yaw[, tilt, roll]): tilt and roll 0 when left out.
+
+        Raises SimulationError for a tilt or roll on a hand without a wrist (:attr:`HandDesign.wrist`)."""
+        target = np.zeros(6)
+        target[:len(base_target)] = base_target
+        if len(self._base_qpos) == 4 and np.any(target[4:] != 0.0):
+            raise SimulationError("the simulated hand has no wrist to tilt or roll: build the scene with "
+                                  "HandDesign(wrist=True) to execute a side or tilted approach")
+        return target[:len(self._base_qpos)]
 
     def step(self, duration: float | None = None) -> None:
         """Advance the simulation by ``duration`` s (one time step if None) at the current commands."""
@@ -317,13 +342,44 @@ class Scene:
         with mujoco_warnings():
             mujoco.mj_step(self.model, self.data, nstep=steps)
 
+    def settle(self, at_least: float) -> None:
+        """Step ``at_least`` s, then on in ``REST_CHECK`` s steps while the object or a neighbour moves faster than
+        ``REST_SPEED`` (its origin's speed, or its turn rate times ``REST_RADIUS``), for at most ``MAX_SETTLE_TIME``
+        s in all: the scene at rest."""
+        self.step(at_least)
+        waited = at_least
+        while waited < MAX_SETTLE_TIME and self._fastest() > REST_SPEED:
+            self.step(REST_CHECK)
+            waited += REST_CHECK
+
+    def _fastest(self) -> float:
+        """The largest speed of the object's and the neighbours' free joints, m/s (a turn rate times ``REST_RADIUS``)."""
+        bodies = np.r_[self._object_body, self._neighbour_bodies].astype(int)
+        dofs = np.concatenate([self.model.jnt_dofadr[self.model.body_jntadr[b]] + np.arange(6) for b in bodies])
+        speeds = self.data.qvel[dofs].reshape(-1, 2, 3)
+        return float(max(np.linalg.norm(speeds[:, 0], axis=1).max(),
+                         REST_RADIUS * np.linalg.norm(speeds[:, 1], axis=1).max()))
+
     @property
     def unstable(self) -> bool:
         """Whether MuJoCo found NaN, infinite or huge accelerations (and reset the state) at some step."""
         return self.data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number > 0
 
 
-BASE_JOINTS = ("hand_x", "hand_y", "hand_z", "hand_yaw")
+def base_angles(R_world_hand) -> tuple[float, float, float]:
+    """(yaw, tilt, roll), rad: the hand base's hinges that turn the hand frame to ``R_world_hand`` (3, 3).
+
+    The palm hangs below the base turned half a turn about x (:func:`~contourgrasp.sim.tendon_hand.base_xml`),
+    and the hinges turn it by yaw about the world's -z, then tilt about the turned y, then roll about the
+    turned -z: ``R_world_hand = Rz(-yaw) Ry(tilt) Rz(-roll) Rx(pi)``. A hand facing straight down has tilt
+    0 and all its turn in yaw.
+    """
+    M = np.asarray(R_world_hand, dtype=float) @ np.diag([1.0, -1.0, -1.0])
+    tilt = math.acos(float(np.clip(M[2, 2], -1.0, 1.0)))
+    if math.sin(tilt) < 1e-9:
+        return -math.atan2(M[1, 0], M[0, 0]), 0.0, 0.0
+    alpha, gamma = math.atan2(M[1, 2], M[0, 2]), math.atan2(M[2, 1], -M[2, 0])
+    return -alpha, tilt, -gamma
 
 
 @contextlib.contextmanager
@@ -383,7 +439,7 @@ def build_scene(obj, *, seed: int, hand: Hand | str = "five-finger-linear", desi
         data = mujoco.MjData(model)
     scene = Scene(model, data, obj, hand_model, camera, placement)
     scene.set_hand(0.0, 0.0, PARK_HEIGHT, 0.0)
-    scene.step(SETTLE_TIME)
+    scene.settle(SETTLE_TIME)
     return scene
 
 

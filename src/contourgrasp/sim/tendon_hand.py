@@ -108,7 +108,8 @@ class HandDesign:
     The hand's geometry (links, radii, knuckles, palm) is not here: it is the hand file's
     (:class:`~contourgrasp.hand.FingerChain`, :class:`~contourgrasp.hand.Palm`). Defaults: a
     0.5 kg hand, a grip of roughly 10 N per finger and 20-30 N at the thumb (the qbHand's
-    datasheet gives ~60 N of grasp force in total).
+    datasheet gives ~60 N of grasp force in total). ``wrist``: the base also tilts and rolls
+    (:func:`base_xml`), as a side or tilted approach needs; off, the base is the thesis's x, y, z, yaw.
     """
 
     finger_density: float = 900.0
@@ -122,6 +123,7 @@ class HandDesign:
     limit_solimp: tuple[float, float, float] = (0.95, 0.99, 0.001)
     base_kp: tuple[float, float] = (4000.0, 200.0)
     base_kv: tuple[float, float] = (250.0, 20.0)
+    wrist: bool = False
 
 
 @dataclass(frozen=True)
@@ -263,7 +265,7 @@ class HandModel:
         t = self.hand.palm.thickness
         contact = f'contype="{HAND_BIT}" conaffinity="{TABLE_BIT}" group="2"'
         lines = [
-            *BASE_XML,
+            *base_xml(d),
             f'    <geom name="palm" type="box" size="{_f((x1 - x0) / 2)} {_f((y1 - y0) / 2)} {_f(t / 2)}" '
             f'pos="{_f((x0 + x1) / 2)} {_f((y0 + y1) / 2)} {_f(-t / 2)}" mass="{_f(d.palm_mass)}" '
             f'rgba="0.25 0.25 0.28 1" {contact}/>',
@@ -330,24 +332,47 @@ class HandModel:
         ])
 
 
-#: The opening lines of a hand's body: the x, y, z, yaw base, and the palm body in the hand frame
-#: (x, -y, -z of the world at yaw 0), left open for the palm's contents and two closing tags.
-BASE_XML = (
-    '<body name="hand_base" gravcomp="1">',
-    '  <joint name="hand_x" type="slide" axis="1 0 0" damping="20"/>',
-    '  <joint name="hand_y" type="slide" axis="0 1 0" damping="20"/>',
-    '  <joint name="hand_z" type="slide" axis="0 0 1" damping="20"/>',
-    '  <joint name="hand_yaw" type="hinge" axis="0 0 -1" damping="1"/>',
-    '  <body name="palm" quat="0 1 0 0" gravcomp="1">',
-)
+#: The base's joints: the x, y, z slides and the yaw hinge, and with a wrist (:attr:`HandDesign.wrist`) the tilt and
+#: roll hinges.
+BASE_JOINTS = ("hand_x", "hand_y", "hand_z", "hand_yaw")
+WRIST_JOINTS = ("hand_tilt", "hand_roll")
+
+#: The tilt and roll servos' gains, as multiples of the yaw servo's.
+TILT_SERVO_GAIN = 10.0
+
+
+def base_xml(design: HandDesign) -> tuple[str, ...]:
+    """The opening lines of a hand's body: the x, y, z, yaw base (and the tilt and roll wrist of ``design.wrist``),
+    and the palm body in the hand frame (x, -y, -z of the world at yaw 0), left open for the palm's contents and
+    two closing tags.
+
+    Tilt turns the approach axis away from the world's -z about the yawed y axis; roll turns the hand about its
+    approach axis (:func:`contourgrasp.sim.scene.base_angles`); at tilt 0 roll and yaw share an axis, and the two
+    hinges' armature keeps the mass matrix regular there.
+    """
+    wrist = (
+        '  <joint name="hand_tilt" type="hinge" axis="0 1 0" damping="1" armature="0.01"/>',
+        '  <joint name="hand_roll" type="hinge" axis="0 0 -1" damping="1" armature="0.01"/>',
+    ) if design.wrist else ()
+    return (
+        '<body name="hand_base" gravcomp="1">',
+        '  <joint name="hand_x" type="slide" axis="1 0 0" damping="20"/>',
+        '  <joint name="hand_y" type="slide" axis="0 1 0" damping="20"/>',
+        '  <joint name="hand_z" type="slide" axis="0 0 1" damping="20"/>',
+        '  <joint name="hand_yaw" type="hinge" axis="0 0 -1" damping="1"/>',
+        *wrist,
+        '  <body name="palm" quat="0 1 0 0" gravcomp="1">',
+    )
 
 
 def base_servos_xml(design: HandDesign) -> str:
-    """The position servos of the hand's base joints (x, y, z, yaw)."""
+    """The position servos of the hand's base joints (x, y, z, yaw; tilt and roll with a wrist)."""
     (kp_lin, kp_yaw), (kv_lin, kv_yaw) = design.base_kp, design.base_kv
     servo = '<position name="{0}" joint="{0}" kp="{1}" kv="{2}" ctrlrange="-10 10"/>'
+    stiff = TILT_SERVO_GAIN
+    wrist = [servo.format(j, _f(stiff * kp_yaw), _f(stiff * kv_yaw)) for j in WRIST_JOINTS] if design.wrist else []
     return "\n".join([*(servo.format(j, _f(kp_lin), _f(kv_lin)) for j in ("hand_x", "hand_y", "hand_z")),
-                      servo.format("hand_yaw", _f(kp_yaw), _f(kv_yaw))])
+                      servo.format("hand_yaw", _f(kp_yaw), _f(kv_yaw)), *wrist])
 
 
 def build_hand(hand: Hand, *, design: HandDesign = HandDesign(), timing: str = "thesis") -> HandModel:

@@ -18,6 +18,11 @@ Execution, given the hand pose ``T_camera_hand`` and the approach depth:
 4. the hand lifts :attr:`Execution.lift_height` and holds for
    :attr:`Execution.hold_time`.
 
+A pose approached from the side or tilted (its z axis not the camera's) is executed as it stands
+(:func:`execute_along`): the hand, on a wrist that tilts and rolls (:attr:`HandDesign.wrist`, which
+:func:`run_trial` gives a planner of such approaches), travels along its approach to the pose in
+step 2 instead, then closes, lifts straight up and holds the same way.
+
 Reading of ``approach_depth``: the thesis's z (3.1.1), the depth of the
 object's top as the camera saw it plus the planner's offset; it bounds the
 palm, not the fingertips.
@@ -35,9 +40,7 @@ Failure causes (chapter 5), first that applies:
 * ``"a finger struck the object while descending"`` -- any hand-object contact
   before closing; the execution stops there, as a robot with a force sensor would;
 * ``"closed without touching the object"`` -- no finger touched the object while
-  closing (the plan's grasp points are not where the object is: on the YCB Windex
-  bottle, the fingers close under the spray head's overhang, round a neck narrower
-  than the head the top-down view shows); it was not lifted;
+  closing (the plan's grasp points are not where the object is); it was not lifted;
 * ``"object pushed away before all fingers touched"`` -- the object had moved
   more than :attr:`Execution.push_tolerance` in the plane when the last finger
   touched it (or closing ended with fingers still on air), and it was not lifted;
@@ -63,7 +66,7 @@ from __future__ import annotations
 import math
 import time
 import warnings
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 
 import cv2
 import numpy as np
@@ -79,7 +82,7 @@ from ..validation import integer
 from .clutter import build_clutter, target_pixel
 from .tendon_hand import HandDesign
 from .render import DEFAULT_SENSOR, Sensor, render, tilted_view
-from .scene import Camera, Scene, Workspace, build_scene
+from .scene import R_WORLD_CAMERA, Camera, Scene, Workspace, base_angles, build_scene
 
 NO_PLAN = "no feasible plan"
 STRUCK = "a finger struck the object while descending"
@@ -92,6 +95,14 @@ HIT = "hit a neighbour or the bin"
 FAILURE_CAUSES = (NO_PLAN, STRUCK, MISSED, PUSHED, SLIPPED, DROPPED, HIT)
 #: Where the hand waits between attempts (world x, y, z of the palm, yaw), far above the table, open.
 PARKED = (0.0, 0.0, 0.6)
+#: How much farther back (m) than its fingertips' reach and the approach height a hand approaching along a
+#: tilted or horizontal axis starts (:func:`execute_along`).
+APPROACH_RUN = 0.05
+#: The most a hand's approach may point up, as the sine of its angle above the horizontal.
+UPWARD_APPROACH = 1e-3
+#: A pose planned in a tilted view whose approach is within this angle of the world's vertical (rad) is a
+#: top-down grasp, executed from the reference camera's frame.
+VERTICAL_APPROACH = math.radians(5.0)
 #: Seconds the scene settles after a failed attempt, the hand parked, before the next picture.
 SETTLE_AFTER_FAILURE = 0.5
 #: After an attempt the closed hand is carried this far (m) along the world's y in this many seconds, out of the
@@ -276,6 +287,7 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
     if attempts > 1 and not hasattr(planner, "plan"):
         raise SimulationError("several attempts need a planner with a plan method that takes memory= "
                               "(contourgrasp.sim.planners)")
+    hand, design = with_wrist(planner, hand, design)
     scene = trial_scene(object_spec, seed=seed, scene_kind=scene_kind, pool=pool, hand=hand, design=design,
                         timing=timing, camera=camera, workspace=workspace, robot=robot)
     if tilt is not None:
@@ -297,7 +309,7 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
         detected.append(seen_lifted(planned, (rgb, depth), after, anywhere=scene_kind == "single"))
         if detected[-1]:
             break
-        memory = memory.with_failure(planned.metric.contour_xy, planned.pose)
+        memory = memory.with_failure(planned.metric.contour_xy, planned.pose, approach=planned.approach)
         scene.set_hand(*PARKED, 0.0)  # the hand opens and leaves; what it held falls where it is
         scene.step(SETTLE_AFTER_FAILURE)
     if observe is not None:
@@ -333,10 +345,12 @@ def _carry_away(scene) -> None:
     """The closed hand, at its height, carried ``CARRY_AWAY`` (m) along the world's y in ``CARRY_TIME`` s, out of the
     camera's view, with what it holds: where a robot shows the camera the table before it tries again."""
     start = scene.hand_base()
+    aside = np.zeros_like(start)
+    aside[1] = CARRY_AWAY
     steps = max(1, round(CARRY_TIME / scene.model.opt.timestep))
     for k in range(steps):
         u = (k + 1) / steps
-        scene.command(start + [0.0, CARRY_AWAY * u * u * (3 - 2 * u), 0.0, 0.0], 1.0)
+        scene.command(start + aside * (u * u * (3 - 2 * u)), 1.0)
         scene.step()
 
 
@@ -359,7 +373,7 @@ def _attempt(scene, planner, rgb, depth, camera: Camera, execution: Execution, m
                 planned = planner.plan(rgb, depth, camera.intrinsics, memory=memory, **target)
                 transform, approach_depth, planned_height = (planned.T_camera_hand, planned.approach_depth,
                                                              [planned.grasp_height])
-        if scene.view is not None:
+        if scene.view is not None and _vertical(scene, transform):
             *pose, approach_depth = scene.to_reference(transform)
             transform = pose_matrix(*pose, approach_depth)
         plan_error = None
@@ -450,6 +464,17 @@ def _standing(depth, intrinsics, plane, below: float) -> np.ndarray:
     return standing
 
 
+def with_wrist(planner, hand, design: HandDesign):
+    """(hand, design) with the simulated hand's wrist (:attr:`HandDesign.wrist`) where ``planner``'s options plan
+    side or tilted approaches; else as given: a top-down planner's trials keep the thesis's x, y, z, yaw base."""
+    options = getattr(planner, "options", None)
+    if options is None or options.scene.approaches == "top":
+        return hand, design
+    if hasattr(hand, "mount"):  # a mounted hand model carries its own design
+        return replace(hand, design=replace(hand.design, wrist=True)), design
+    return hand, replace(design, wrist=True)
+
+
 def trial_scene(object_spec, *, seed: int, scene_kind: str = "single", pool=(), **options) -> Scene:
     """The settled scene of a trial: :func:`~contourgrasp.sim.scene.build_scene` for ``"single"``, else
     :func:`~contourgrasp.sim.clutter.build_clutter` (``pool``: its neighbours); ``options`` go to either."""
@@ -492,8 +517,12 @@ def execute_grasp(scene: Scene, transform, approach_depth: float, execution: Exe
 
     ``grasp_height`` (m), when the planner chose one: the height above the table of the open hand's
     lowest fingertip (its tip centre) at the end of the descent, executed as planned instead of
-    the palm-clearance rule of step 2.
+    the palm-clearance rule of step 2. A ``transform`` whose approach is not the camera's axis (a side
+    or tilted approach) is executed as it stands (:func:`execute_along`); ``approach_depth`` and
+    ``grasp_height`` are then not used.
     """
+    if not _top_down(transform):
+        return execute_along(scene, transform, execution)
     x, y, yaw = hand_pose_from_matrix(transform)
     world_xy = scene.camera.to_world([x, y, 0.0])[:2]
     top = scene.camera.height - float(approach_depth)  # the planner's idea of the object's top, world z
@@ -507,17 +536,60 @@ def execute_grasp(scene: Scene, transform, approach_depth: float, execution: Exe
                                   "it cannot execute a planned grasp height")
         palm_final = depth + float(grasp_height)
     palm_start = max(palm_final, top + execution.approach_height + scene.hand.tip_depth)
-    probe = _Probe(scene)
-    pose = (x, y, yaw)
-    rest = scene.neighbour_coms()
+    end = np.array([*world_xy, palm_final, yaw, 0.0, 0.0])
+    start = end + [0.0, 0.0, palm_start - palm_final, 0.0, 0.0, 0.0]
+    return _grasp(scene, start, end, (x, y, yaw), execution)
 
-    scene.set_hand(*world_xy, palm_start, yaw)
-    if _descend(scene, probe, world_xy, yaw, palm_start, palm_final, execution):
+
+def execute_along(scene: Scene, transform, execution: Execution = Execution()) -> GraspOutcome:
+    """Execute a grasp approached along its hand frame's z axis: the open hand starts
+    ``hand.tip_depth + execution.approach_height + APPROACH_RUN`` back along it, travels to the pose
+    ``transform`` (``T_camera_hand``, or the tilted view's ``T_view_hand``), closes and lifts straight up.
+    """
+    t = np.asarray(transform, dtype=float)
+    if t.shape != (4, 4) or not np.all(np.isfinite(t)):
+        raise SimulationError(f"T_camera_hand must be a finite (4, 4) matrix, got shape {t.shape}")
+    if scene.view is None:
+        position, R_world_hand = scene.camera.to_world(t[:3, 3]), R_WORLD_CAMERA @ t[:3, :3]
+    else:
+        eye, R_world_view = scene.view
+        position, R_world_hand = R_world_view @ t[:3, 3] + eye, R_world_view @ t[:3, :3]
+    if R_world_hand[2, 2] > UPWARD_APPROACH:
+        raise SimulationError("T_camera_hand faces away from the table: its z axis (the approach) points up "
+                              f"{math.degrees(math.asin(min(1.0, R_world_hand[2, 2]))):.0f} deg")
+    end = np.array([*position, *base_angles(R_world_hand)])
+    back = scene.hand.tip_depth + execution.approach_height + APPROACH_RUN
+    start = end - np.r_[back * R_world_hand[:, 2], 0.0, 0.0, 0.0]
+    camera_xy = scene.camera.from_world(position)[:2]
+    yaw = math.atan2(t[1, 0], t[0, 0])
+    return _grasp(scene, start, end, (float(camera_xy[0]), float(camera_xy[1]), yaw), execution)
+
+
+def _vertical(scene: Scene, T_view_hand) -> bool:
+    """Whether a pose planned in the tilted view's frame approaches along the world's vertical, within
+    ``VERTICAL_APPROACH`` (the planner's table normal is a fraction of a degree off it)."""
+    _, R_world_view = scene.view
+    return float((R_world_view @ np.asarray(T_view_hand, dtype=float)[:3, 2])[2]) < -math.cos(VERTICAL_APPROACH)
+
+
+def _top_down(transform) -> bool:
+    """Whether ``transform``'s approach (its z axis) is the camera's within a millionth (not checked further)."""
+    t = np.asarray(transform, dtype=float)
+    return t.shape != (4, 4) or not np.isfinite(t[2, 2]) or t[2, 2] >= 1 - 1e-6
+
+
+def _grasp(scene: Scene, start, end, pose, execution: Execution) -> GraspOutcome:
+    """Travel from the base pose ``start`` to ``end`` (x, y, z, yaw, tilt, roll), close, lift and hold; the outcome."""
+    probe = _Probe(scene)
+    rest = scene.neighbour_coms()
+    palm_depth = scene.camera.height - float(end[2])
+    scene.set_hand(*start[:4], tilt=start[4], roll=start[5])
+    if _descend(scene, probe, start, end, execution):
         cause = HIT if probe.hit and not probe.touching() else STRUCK
-        return GraspOutcome(False, cause, (), (), 0.0, 0.0, 0.0, pose, scene.camera.height - palm_final)
-    first_contact, push = _close(scene, probe, world_xy, yaw, palm_final, execution)
+        return GraspOutcome(False, cause, (), (), 0.0, 0.0, 0.0, pose, palm_depth)
+    first_contact, push = _close(scene, probe, end, execution)
     touching = probe.fingers_touching()
-    lift, lifted, drift = _lift_and_hold(scene, world_xy, yaw, palm_final, execution)
+    lift, lifted, drift = _lift_and_hold(scene, end, execution)
     success = lift >= execution.success_lift and drift < execution.hold_tolerance
     if success:
         cause = None
@@ -529,8 +601,7 @@ def execute_grasp(scene: Scene, transform, approach_depth: float, execution: Exe
         cause = PUSHED if push > execution.push_tolerance else SLIPPED
     if probe.hit or scene.displaced_neighbours(rest):
         success, cause = False, HIT
-    return GraspOutcome(success, cause, touching, first_contact, push, lift, drift, pose,
-                        scene.camera.height - palm_final)
+    return GraspOutcome(success, cause, touching, first_contact, push, lift, drift, pose, palm_depth)
 
 
 class _Probe:
@@ -572,11 +643,14 @@ class _Probe:
         return tuple(names[i] for i in sorted(self.touching()) if i >= 0)
 
 
-def _descend(scene, probe, xy, yaw, z_start, z_end, execution) -> bool:
-    """Lower the palm from z_start to z_end; True when the hand touched the object (or an obstacle) on the way."""
-    steps = max(1, round((z_start - z_end) / execution.descend_speed / scene.model.opt.timestep))
-    for z in np.linspace(z_start, z_end, steps):
-        scene.command([*xy, z, yaw], 0.0)
+def _descend(scene, probe, start, end, execution) -> bool:
+    """Move the open hand's base from ``start`` to ``end`` (6,) at the descent speed; True when the hand touched the
+    object (or an obstacle) on the way."""
+    start, end = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
+    run = float(np.linalg.norm(end[:3] - start[:3]))
+    steps = max(1, round(run / execution.descend_speed / scene.model.opt.timestep))
+    for u in np.linspace(0.0, 1.0, steps):
+        scene.command(start + u * (end - start), 0.0)
         scene.step()
         if probe.touching() or probe.hit:
             return True
@@ -587,7 +661,7 @@ def _descend(scene, probe, xy, yaw, z_start, z_end, execution) -> bool:
     return False
 
 
-def _close(scene, probe, xy, yaw, z, execution):
+def _close(scene, probe, base, execution):
     """Ramp the tendon force up, then squeeze; per finger first-contact times and the push before the last."""
     dt = scene.model.opt.timestep
     start_xy = scene.object_position()[:2]
@@ -597,7 +671,7 @@ def _close(scene, probe, xy, yaw, z, execution):
     max_push = 0.0
     ramp = round(execution.close_time / dt)
     for k in range(ramp + round(execution.squeeze_time / dt)):
-        scene.command([*xy, z, yaw], min(1.0, (k + 1) / ramp))
+        scene.command(base, min(1.0, (k + 1) / ramp))
         scene.step()
         max_push = max(max_push, float(np.linalg.norm(scene.object_position()[:2] - start_xy)))
         for i in probe.touching() - first.keys() - {-1}:
@@ -609,14 +683,16 @@ def _close(scene, probe, xy, yaw, z, execution):
     return order, max_push if push_at_last is None else push_at_last
 
 
-def _lift_and_hold(scene, xy, yaw, z, execution):
+def _lift_and_hold(scene, base, execution):
     """Lift smoothly, hold; the object's rise (end of hold, end of lift) and its largest drift in the hand."""
     dt = scene.model.opt.timestep
     z0 = scene.object_com()[2]
     steps = max(1, round(execution.lift_height / execution.lift_speed / dt))
+    up = np.zeros(len(base))
+    up[2] = execution.lift_height
     for k in range(steps):
         u = (k + 1) / steps
-        scene.command([*xy, z + execution.lift_height * u * u * (3 - 2 * u), yaw], 1.0)  # smoothstep
+        scene.command(base + up * (u * u * (3 - 2 * u)), 1.0)  # smoothstep
         scene.step()
     lifted = scene.object_com()[2] - z0
     reference = _in_palm(scene)

@@ -10,6 +10,11 @@ ball) has no axis that turns with it, and its frame keeps the planning frame's o
 
 :func:`contourgrasp.pipeline.plan_frame` takes a :class:`GraspMemory` (``memory=``), which
 :func:`~contourgrasp.synthesis.search` applies to its screened poses (``exclude=``).
+
+A grasp approached from the side or tilted (:mod:`contourgrasp.perception.view_along`) is kept as its
+kind of approach only: the next plan tries the kinds that failed fewer times first
+(:func:`contourgrasp.pipeline.approach_order`). Its pose is not kept: the approach frame is the object's
+as seen along that approach, and the next plan may see it along another.
 """
 
 from __future__ import annotations
@@ -21,6 +26,7 @@ import numpy as np
 
 from .. import validation
 from ..errors import PlannerError
+from ..perception.view_along import APPROACH_KINDS
 from ..tolerances import MAX_MEMORY_FAILURES, MEMORY_REACH, MEMORY_ROUND, MEMORY_TURN
 
 
@@ -41,17 +47,27 @@ class GraspMemory:
     """
 
     failures: tuple[tuple[float, float, float], ...] = ()
+    kinds: tuple[str, ...] = ()
 
     def __len__(self) -> int:
-        return len(self.failures)
+        return len(self.kinds)
 
-    def with_failure(self, contour_xy, pose) -> GraspMemory:
-        """This memory and the failed grasp ``pose`` (x, y, yaw) planned on the outline ``contour_xy`` ((n, 2) m)."""
+    def with_failure(self, contour_xy, pose, *, approach: str = "top") -> GraspMemory:
+        """This memory and the failed grasp ``pose`` (x, y, yaw) planned on the outline ``contour_xy`` ((n, 2) m),
+        approached as ``approach`` says ("top", "side" or "tilted"; of the latter two only the kind is kept)."""
         x, y, yaw = validation.finite_array("pose", pose, (3,), error=PlannerError)
+        approach = validation.choice("approach", approach, APPROACH_KINDS, error=PlannerError)
+        kinds = (*self.kinds, approach)[-MAX_MEMORY_FAILURES:]
+        if approach != "top":
+            return GraspMemory(self.failures[-kinds.count("top"):] if "top" in kinds else (), kinds)
         centre, angle = object_frame(contour_xy)
         local = _rotation(-angle) @ (np.array([x, y]) - centre)
         kept = (*self.failures, (float(local[0]), float(local[1]), float(_wrapped(yaw - angle))))
-        return GraspMemory(kept[-MAX_MEMORY_FAILURES:])
+        return GraspMemory(kept[-kinds.count("top"):], kinds)
+
+    def failures_by_kind(self) -> dict[str, int]:
+        """How many grasps failed per kind of approach."""
+        return {kind: self.kinds.count(kind) for kind in dict.fromkeys(self.kinds)}
 
     def excluded(self, contour_xy, poses) -> np.ndarray:
         """(n,) bool: the poses (n, 3) near a failure, the failures mapped onto the outline ``contour_xy`` ((m, 2) m)."""

@@ -18,9 +18,28 @@ from .. import validation as check
 from ..contour import CURVATURE_MODES, CurvatureMode
 from ..errors import PlannerError
 from ..hand import SLICE_CONTOUR as HAND_SLICE_CONTOUR
+from ..perception.view_along import APPROACH_KINDS
 from .grasp_height import check_rule as check_grasp_height
 from .grid import SearchGrid
 from .safeguards import Safeguards
+
+def check_approaches(approaches) -> str:
+    """``approaches`` if it is kinds of :data:`APPROACH_KINDS` joined by ``+``, each once (their order is kept).
+
+    Raises
+    ------
+    PlannerError
+        Not a string, an unknown kind or one named twice, naming ``approaches``.
+    """
+    if not isinstance(approaches, str):
+        raise PlannerError(f"approaches must be a string of {', '.join(APPROACH_KINDS)} joined by '+', "
+                           f"got {approaches!r}")
+    kinds = approaches.split("+")
+    for kind in kinds:
+        check.choice("approaches", kind, APPROACH_KINDS, error=PlannerError)
+    if len(set(kinds)) < len(kinds):
+        raise PlannerError(f"approaches names a kind twice: {approaches!r}")
+    return approaches
 
 #: The values of :attr:`SceneOptions.slice_contour`: a hand's, or the hand's own.
 SLICE_CONTOUR = (*HAND_SLICE_CONTOUR, "hand")
@@ -103,6 +122,13 @@ class SceneOptions:
     low_objects : bool
         Plan an object lower than ``tolerances.LOW_OBJECT_HEIGHT`` first as a pinch of the thumb against
         one finger with the fingertips as balls.
+    approaches : str
+        The approach kinds a plan tries, in order: kinds of :data:`APPROACH_KINDS` joined by ``+``, e.g.
+        ``"top"`` (top-down only, the thesis's), ``"top+tilted"`` (tilted where top-down has no feasible
+        pose, or where it failed: :func:`contourgrasp.pipeline.approach_order`), ``"side"`` (a shelf, an arm
+        that cannot reach over the object). ``side``: horizontal, ``tilted``: 45 deg down, each from four
+        directions along and across the object's footprint, the lowest cost among them
+        (:func:`contourgrasp.pipeline.approach_set`); they need ``descent`` and a table (docs/approaches.md).
 
     Raises
     ------
@@ -116,6 +142,7 @@ class SceneOptions:
     closing_sweep: bool = False
     closing_obstacles: bool = False
     low_objects: bool = False
+    approaches: str = "top"
 
     def __post_init__(self):
         for name in ("descent", "closing_sweep", "closing_obstacles", "low_objects"):
@@ -124,6 +151,7 @@ class SceneOptions:
             object.__setattr__(self, "grasp_height", check_grasp_height(self.grasp_height))
         object.__setattr__(self, "slice_contour", check.choice("slice_contour", self.slice_contour, SLICE_CONTOUR,
                                                                error=PlannerError))
+        object.__setattr__(self, "approaches", check_approaches(self.approaches))
 
 
 def _check_harmonics(harmonics) -> None:
