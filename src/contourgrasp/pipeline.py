@@ -365,6 +365,17 @@ def _best_along(kind: str, heights: HeightMap, hand: Hand, scene_options: SceneO
     return best, best_view
 
 
+def plan_to_camera(metric: MetricContour, view: ApproachView | None, grasp_height: float | None, xy) -> np.ndarray:
+    """(n, 3) float: camera-frame points of a plan's frame's points (n, 2): in the contour's plane for a top-down
+    plan (``view`` None), at ``grasp_height`` in front of the reference plane (where the fingertips close) for a side
+    or tilted one (:attr:`ImageGraspPlan.view`)."""
+    if view is None:
+        return metric.to_camera(xy)
+    xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+    plane = view.to_plane(np.c_[xy, np.full(len(xy), -grasp_height)])
+    return metric.origin + plane @ metric.R_camera_plane.T
+
+
 def _view_metric(metric: MetricContour, view: ApproachView) -> MetricContour:
     """``metric`` with the approach frame of ``view`` as its planning frame (its contour the outline seen along it)."""
     return replace(metric, contour_xy=view.contour_xy, R_camera_plane=metric.R_camera_plane @ view.R_plane_view,

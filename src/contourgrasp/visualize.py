@@ -18,6 +18,7 @@ from mpl_toolkits.axes_grid1.anchored_artists import AnchoredSizeBar
 
 from .contour import clean_polygon, efd
 from .hand import chain_capsules, chain_plane, to_image
+from .pipeline import plan_to_camera
 from .synthesis import GraspPlan
 
 CONVEX_COLOUR = "0.25"
@@ -143,13 +144,9 @@ def harmonics_figure(contour_xy, harmonics: Sequence[int] = (1, 2, 4, 8), *, cur
 
 
 def _to_pixels(result, points_xy, shift=(0, 0)) -> np.ndarray:
-    """(n, 2) float: pixels of planning-frame points (n, 2) in the contour's plane, less ``shift``; of a side or
-    tilted approach's frame, at the plan's grasp height (where the fingertips close)."""
-    if result.view is None:
-        return result.camera.project(result.metric.to_camera(points_xy)) - shift
-    xy = np.asarray(points_xy, dtype=float).reshape(-1, 2)
-    plane = result.view.to_plane(np.c_[xy, np.full(len(xy), -result.grasp_height)])
-    return result.camera.project(result.metric.origin + plane @ result.metric.R_camera_plane.T) - shift
+    """(n, 2) float: pixels of the plan's frame's points (n, 2) (:func:`contourgrasp.pipeline.plan_to_camera`), less
+    ``shift``."""
+    return result.camera.project(plan_to_camera(result.metric, result.view, result.grasp_height, points_xy)) - shift
 
 
 def image_plan_figure(result, rgb=None) -> Figure:

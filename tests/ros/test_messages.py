@@ -168,3 +168,20 @@ def test_markers_lie_on_the_contour_and_in_the_fingertips_plane(result):
                                    [start.pose.position.x, start.pose.position.y, start.pose.position.z], atol=1e-9)
     missed = [m.color.r > 0.5 and m.color.g < 0.5 for m in array if m.ns == "grasp"]
     assert missed == [f.missed for f in result.plan.fingers]
+
+
+def test_markers_of_a_tilted_plan_lie_in_its_approach_frame_at_the_grasp_height():
+    rgb, depth, intrinsics = bar_clamp()
+    tilted = contourgrasp.plan_grasp(rgb, depth, intrinsics, "five-finger-linear", planner="default",
+                                     approaches="tilted")
+    array = messages.plan_markers(tilted, header(3.0)).markers
+    view, metric = tilted.view, tilted.metric
+    R_camera_view = metric.R_camera_plane @ view.R_plane_view
+    origin = metric.origin + metric.R_camera_plane @ view.origin
+    np.testing.assert_allclose(R_camera_view[:, 2], tilted.T_camera_hand[:3, 2], atol=1e-12)
+    outline = np.array([[p.x, p.y, p.z] for p in array[1].points])
+    np.testing.assert_allclose((outline - origin) @ R_camera_view[:, :2], np.vstack([view.contour_xy,
+                                                                                      view.contour_xy[:1]]), atol=1e-9)
+    tips = np.array([[m.pose.position.x, m.pose.position.y, m.pose.position.z] for m in array
+                     if m.ns in ("start", "grasp")])
+    np.testing.assert_allclose((tips - origin) @ R_camera_view[:, 2], -tilted.grasp_height, atol=1e-9)

@@ -208,8 +208,8 @@ def view_along(heights: HeightMap, approach: Approach, *, points=None) -> Approa
     cell = heights.cell * VIEW_CELL
     low = local[target, :2].min(axis=0) - VIEW_MARGIN
     shape = tuple((np.ceil((local[target, :2].max(axis=0) + VIEW_MARGIN - low) / cell).astype(int) + 1)[::-1])
-    near, near_target = (_nearest(shape, (local[near_enough & keep] - [*low, 0.0]) / [cell, cell, 1.0])
-                         for keep in (True, target))
+    cells = (local[near_enough] - [*low, 0.0]) / [cell, cell, 1.0]
+    near, near_target = _nearest(shape, cells), _nearest(shape, cells[target[near_enough]])
     centres = [low[k] + (np.arange(shape[1 - k]) + 0.5) * cell for k in (0, 1)]
     table = _table_depth(R, origin, n, float(heights.table_offset), *centres)
     object_cells = np.isfinite(near_target) & (near_target <= np.minimum(near, table))  # the target, seen first

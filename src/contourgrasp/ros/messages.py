@@ -23,6 +23,7 @@ from .. import tolerances as tol
 from ..errors import InputError
 from ..hand import to_image
 from ..perception import Intrinsics
+from ..pipeline import plan_to_camera
 
 #: Encodings of sensor_msgs/Image read: (numpy dtype, channels).
 ENCODINGS = {
@@ -244,23 +245,29 @@ def plan_markers(result, header):
     at depth z_max or on the table), ``path`` (one line per finger, open to
     closed), ``start`` and ``grasp`` (a sphere per finger; grasp points of
     fingers that miss are red). Paths, starts and grasp points lie in the
-    fingertips' plane, at the approach depth. A DELETEALL marker comes first,
-    so markers of an earlier plan do not linger.
+    fingertips' plane, at the approach depth; a side or tilted plan's in its
+    approach frame, at its grasp height (:func:`contourgrasp.pipeline.plan_to_camera`).
+    A DELETEALL marker comes first, so markers of an earlier plan do not linger.
     """
     from visualization_msgs.msg import Marker, MarkerArray
 
     metric, plan = result.metric, result.plan
     clear = Marker(action=Marker.DELETEALL)
     clear.header.frame_id, clear.header.stamp = header.frame_id, header.stamp
-    outline = np.vstack([metric.contour_xy, metric.contour_xy[:1]])
-    markers = [clear, _marker(Marker.LINE_STRIP, "outline", 0, metric.to_camera(outline), header, "outline")]
-    tips = metric.approach_depth
+    if result.view is None:
+        contour, tips = metric.contour_xy, metric.approach_depth
+        outline_at, tips_at = metric.to_camera, lambda xy: metric.to_camera(xy, depth=tips)
+    else:  # a side or tilted plan: its outline and fingers in its approach frame, at the grasp height
+        contour = result.view.contour_xy
+        outline_at = tips_at = lambda xy: plan_to_camera(metric, result.view, result.grasp_height, xy)
+    outline = np.vstack([contour, contour[:1]])
+    markers = [clear, _marker(Marker.LINE_STRIP, "outline", 0, outline_at(outline), header, "outline")]
     for i, (finger, contact) in enumerate(zip(plan.hand.fingers, plan.fingers)):
         path = to_image(finger.points(np.linspace(0.0, finger.travel, 30)), plan.pose)
-        markers.append(_marker(Marker.LINE_STRIP, "path", i, metric.to_camera(path, depth=tips), header, "path"))
+        markers.append(_marker(Marker.LINE_STRIP, "path", i, tips_at(path), header, "path"))
         for ns, point in (("start", contact.start), ("grasp", contact.grasp_point)):
             colour = "missed" if ns == "grasp" and contact.missed else ns
-            markers.append(_marker(Marker.SPHERE, ns, i, metric.to_camera([point], depth=tips), header, colour))
+            markers.append(_marker(Marker.SPHERE, ns, i, tips_at([point]), header, colour))
     return MarkerArray(markers=markers)
 
 

@@ -111,6 +111,8 @@ class PlannedGrasp:
         camera's ``segmentation`` is the object's footprint on the table instead.
     approach : str
         The plan's kind of approach: "top", "side" or "tilted" (:attr:`contourgrasp.perception.Approach.kind`).
+    view : ApproachView or None
+        A side or tilted plan's view (``pose`` is in its frame); None for a top-down plan.
     """
 
     pose: np.ndarray
@@ -123,6 +125,7 @@ class PlannedGrasp:
     grasp_height: float | None = None
     seen: np.ndarray | None = None
     approach: str = "top"
+    view: perception.ApproachView | None = None
 
 
 @dataclass(frozen=True)
@@ -147,7 +150,7 @@ class SynthesisPlanner(_Planner):
                                      memory=memory)
         return PlannedGrasp(result.plan.pose, result.T_camera_hand, result.metric.approach_depth,
                             result.segmentation, result.metric, result.camera, result.plan, result.grasp_height,
-                            None if result.target is None else result.target.mask, result.approach.kind)
+                            None if result.target is None else result.target.mask, result.approach.kind, result.view)
 
 
 @dataclass(frozen=True)

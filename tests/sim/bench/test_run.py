@@ -49,3 +49,21 @@ def _record(obj, success):
     return TrialRecord(object=obj, seed=0, success=success, cause=None if success else "dropped",
                        fingers_in_contact=(), first_contact=(), push=0.0, lift=0.0, hold_drift=0.0, pose=None,
                        approach_depth=None, grasp_height=None, plan_error=None, sim_time=1.0, plan_time=0.1, wall_time=1.0)
+
+
+def test_a_trial_of_a_planner_that_approaches_tilted_reproduces_for_its_snapshot(tmp_path):
+    """The failure mosaic reruns a trial through a recording planner: the hand must get its wrist there too."""
+    from pathlib import Path
+
+    import contourgrasp
+    from contourgrasp.sim.bench.run import snapshot
+    from contourgrasp.sim.objects import soda_can
+
+    default = Path(contourgrasp.__file__).parent / "data" / "planners" / "default.toml"
+    tilted = tmp_path / "tilted.toml"
+    tilted.write_text(default.read_text().replace('name = "default"', 'name = "tilted"') + 'approaches = "tilted"\n')
+    bench = Bench(objects=(soda_can(standing=True),), planners=(str(tilted),), trials=1, sensor="basic")
+    result = run_bench(bench)[0]
+    assert result.record.pose is not None
+    shot = snapshot(bench, result)
+    assert shot.planned.approach == "tilted"

@@ -10,6 +10,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ...hand import to_image
+from ...pipeline import plan_to_camera
 from ...visualize import FINGER_COLOURS
 from .config import SHORT_CAUSES, Bench, label
 from .stats import records, sort_planner, success_rates, thesis_rates, wilson_interval
@@ -157,5 +158,5 @@ def draw_side_panel(ax, snap) -> None:
 
 
 def _pixels(planned, points_xy) -> np.ndarray:
-    """(n, 2) float: pixels of planning-frame points (n, 2) in the contour's plane."""
-    return planned.camera.project(planned.metric.to_camera(points_xy))
+    """(n, 2) float: pixels of the plan's frame's points (n, 2) (:func:`contourgrasp.pipeline.plan_to_camera`)."""
+    return planned.camera.project(plan_to_camera(planned.metric, planned.view, planned.grasp_height, points_xy))
