@@ -265,25 +265,10 @@ def plan_frame(
             raise PlannerError(f"approaches {scene_options.approaches!r} need descent=True and a 3-D hand "
                                f"(its file's chains): a side or tilted hand is checked against the scene in 3-D")
         raise NoFeasibleGrasp(f"approaches {scene_options.approaches!r} need a table plane: none was found")
-    plan, view, top_down_error = None, None, None
-    for kind in kinds:  # the first kind's plan, or the first that balances the squeeze where that one does not
-        found, seen_along = None, None
-        if kind == "top":
-            try:
-                found = search(metric.contour_xy if section is None else section, hand, search_options, descent=spec,
-                               balanced_alternative=on_section, low_object=low, exclude=exclude)
-            except NoFeasibleGrasp as err:
-                top_down_error = err
-        else:
-            found, seen_along = _best_along(kind, heights, hand, scene_options, search_options)
-        if found is not None and (plan is None or found.balanced):
-            plan, view = found, seen_along
-        if plan is not None and plan.balanced:
-            break
-    if plan is None:
-        raise top_down_error if kinds == ["top"] else NoFeasibleGrasp(
-            f"no feasible grasp along any approach of {scene_options.approaches!r}"
-            + ("" if top_down_error is None else f"; top-down: {top_down_error}"))
+    top_down = partial(search, metric.contour_xy if section is None else section, hand, search_options, descent=spec,
+                       balanced_alternative=on_section, low_object=low, exclude=exclude)
+    plan, view = _plan_kinds(kinds, top_down, partial(_best_along, heights=heights, hand=hand,
+                                                      scene_options=scene_options, search_options=search_options))
     tip_height = None if asked is None else asked[0] if plan.descent is None else float(plan.descent.tip_height[0])
     frame, frame_heights = (metric, heights) if view is None else (_view_metric(metric, view), view.heights)
     depth_at = (metric.approach_depth if tip_height is None
@@ -294,6 +279,34 @@ def plan_frame(
     T_base_hand = None if T_base_camera is None else T_base_camera @ T_camera_hand
     return ImageGraspPlan(plan, seg, metric, intrinsics, T_camera_hand, T_camera_pregrasp, T_base_hand, filled,
                           heights, *scene, grasp_height=tip_height, view=view)
+
+
+def _plan_kinds(kinds, top_down, along) -> tuple[GraspPlan, ApproachView | None]:
+    """The plan of the first kind in ``kinds`` with a feasible pose, or of the first after it that balances the
+    squeeze where it does not (:func:`approach_order`), and its view (None: top-down).
+
+    ``top_down()`` plans top-down (raising NoFeasibleGrasp), ``along(kind)`` a side or tilted kind ((None, None):
+    none). Raises the top-down reason when top-down alone was asked for and failed, else NoFeasibleGrasp."""
+    plan, view, top_down_error = None, None, None
+    for kind in kinds:
+        found, seen_along = None, None
+        if kind == "top":
+            try:
+                found = top_down()
+            except NoFeasibleGrasp as err:
+                top_down_error = err
+        else:
+            found, seen_along = along(kind)
+        if found is not None and (plan is None or found.balanced):
+            plan, view = found, seen_along
+        if plan is not None and plan.balanced:
+            return plan, view
+    if plan is not None:
+        return plan, view
+    if kinds == ["top"]:
+        raise top_down_error
+    raise NoFeasibleGrasp(f"no feasible grasp along any approach of {'+'.join(kinds)!r}"
+                          + ("" if top_down_error is None else f"; top-down: {top_down_error}"))
 
 
 #: The top-down approach: along the table's normal, into it.
@@ -339,7 +352,7 @@ def approach_order(approaches: str, memory: GraspMemory | None = None) -> list[s
     return sorted(kinds, key=lambda kind: failed.get(kind, 0))
 
 
-def _best_along(kind: str, heights: HeightMap, hand: Hand, scene_options: SceneOptions,
+def _best_along(kind: str, *, heights: HeightMap, hand: Hand, scene_options: SceneOptions,
                 search_options: SearchOptions) -> tuple[GraspPlan | None, ApproachView | None]:
     """The lowest-cost plan along the approaches of ``kind`` (:func:`approach_set`), of those that balance the squeeze
     where one does, and its view; (None, None) when none has a feasible pose. Each is planned on the target's cross-section at the grasp height asked
