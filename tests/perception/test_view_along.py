@@ -120,6 +120,7 @@ def test_a_top_down_view_is_refused(box, approach, message):
     ({"elevation": float("nan")}, "finite"),
     ({"elevation": 0.0, "azimuth": "north"}, "azimuth"),
     ({"elevation": True}, "elevation"),
+    ({"elevation": 0.0, "azimuth": 10**400}, "azimuth must be a finite number"),
 ])
 def test_bad_approaches_are_refused_by_name(kwargs, message):
     with pytest.raises(PerceptionError, match=message):

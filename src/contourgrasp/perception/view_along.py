@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from .. import validation
 from ..errors import PerceptionError
 from ..tolerances import MIN_HEIGHT, VIEW_CELL, VIEW_MARGIN
 from .height_map import HeightMap
@@ -65,14 +66,12 @@ class Approach:
     azimuth: float = 0.0
 
     def __post_init__(self):
-        for name in ("elevation", "azimuth"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating)) or not math.isfinite(value):
-                raise PerceptionError(f"Approach.{name} must be a finite number of radians, got {value!r}")
-        if not 0.0 <= self.elevation <= math.pi / 2:
-            raise PerceptionError(f"Approach.elevation must be in [0, pi/2] rad, got {self.elevation!r}")
-        object.__setattr__(self, "elevation", float(self.elevation))
-        object.__setattr__(self, "azimuth", float(self.azimuth) % (2 * math.pi))
+        elevation = validation.finite("Approach.elevation", self.elevation, error=PerceptionError)
+        azimuth = validation.finite("Approach.azimuth", self.azimuth, error=PerceptionError)
+        if not 0.0 <= elevation <= math.pi / 2:
+            raise PerceptionError(f"Approach.elevation must be in [0, pi/2] rad, got {elevation!r}")
+        object.__setattr__(self, "elevation", elevation)
+        object.__setattr__(self, "azimuth", azimuth % (2 * math.pi))
 
     @property
     def top_down(self) -> bool:
