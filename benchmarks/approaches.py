@@ -31,7 +31,6 @@ from contourgrasp.sim.render import DEFAULT_SENSOR, render
 from contourgrasp.sim.tendon_hand import HandDesign
 from contourgrasp.sim.trial import execute_grasp, trial_scene
 from contourgrasp.sim.ycb import load_object, object_names
-from contourgrasp.synthesis.outer import NOTE_UNBALANCED
 
 KINDS = ("top", "side", "tilted")
 CHOICES = ("top+side", "top+tilted", "top+side+tilted")
@@ -57,13 +56,8 @@ def one_trial(job):
             continue
         outcome = execute_grasp(scene, plan.T_camera_hand, plan.metric.approach_depth, grasp_height=plan.grasp_height)
         record[kind] = {"cost": plan.plan.cost.total, "success": bool(outcome.success), "cause": outcome.cause,
-                        "approach": plan.approach.describe(), "balanced": balanced(plan.plan)}
+                        "approach": plan.approach.describe(), "balanced": plan.plan.balanced}
     return record
-
-
-def balanced(plan) -> bool:
-    """Whether the search found a pose that balances the squeeze (no note that it planned without)."""
-    return not any(note.startswith(NOTE_UNBALANCED.split("{")[0]) for note in plan.search_notes)
 
 
 def chosen(record, kinds, penalty):

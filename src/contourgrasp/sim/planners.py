@@ -109,8 +109,6 @@ class PlannedGrasp:
     seen : (H, W) bool or None
         The pixels that see the object (the target candidate's), where perception chose one; a tilted
         camera's ``segmentation`` is the object's footprint on the table instead.
-    approach : str
-        The plan's kind of approach: "top", "side" or "tilted" (:attr:`contourgrasp.perception.Approach.kind`).
     view : ApproachView or None
         A side or tilted plan's view (``pose`` is in its frame); None for a top-down plan.
     """
@@ -124,8 +122,12 @@ class PlannedGrasp:
     plan: synthesis.GraspPlan | None
     grasp_height: float | None = None
     seen: np.ndarray | None = None
-    approach: str = "top"
     view: perception.ApproachView | None = None
+
+    @property
+    def approach(self) -> str:
+        """The plan's kind of approach: "top", "side" or "tilted" (:attr:`contourgrasp.perception.Approach.kind`)."""
+        return "top" if self.view is None else self.view.approach.kind
 
 
 @dataclass(frozen=True)
@@ -150,7 +152,7 @@ class SynthesisPlanner(_Planner):
                                      memory=memory)
         return PlannedGrasp(result.plan.pose, result.T_camera_hand, result.metric.approach_depth,
                             result.segmentation, result.metric, result.camera, result.plan, result.grasp_height,
-                            None if result.target is None else result.target.mask, result.approach.kind, result.view)
+                            None if result.target is None else result.target.mask, result.view)
 
 
 @dataclass(frozen=True)
