@@ -151,6 +151,11 @@ class ImageGraspPlan:
         """The direction the hand approaches along (top-down unless :attr:`view`)."""
         return TOP_DOWN if self.view is None else self.view.approach
 
+    @property
+    def frame(self) -> MetricContour:
+        """The frame ``plan`` is in (:func:`plan_metric`): ``metric``'s, or the approach frame of :attr:`view`."""
+        return plan_metric(self.metric, self.view)
+
 
 def plan_frame(
     rgb,
@@ -270,9 +275,9 @@ def plan_frame(
     plan, view = _plan_kinds(kinds, top_down, partial(_best_along, heights=heights, hand=hand,
                                                       scene_options=scene_options, search_options=search_options))
     tip_height = None if asked is None else asked[0] if plan.descent is None else float(plan.descent.tip_height[0])
-    frame, frame_heights = (metric, heights) if view is None else (_view_metric(metric, view), view.heights)
+    frame = plan_metric(metric, view)
     depth_at = (metric.approach_depth if tip_height is None
-                else palm_depth(frame, frame_heights, hand, plan.pose, tip_height))
+                else palm_depth(frame, heights if view is None else view.heights, hand, plan.pose, tip_height))
     T_camera_hand = hand_pose(frame, plan.pose, depth_at)
     T_camera_pregrasp = T_camera_hand.copy()
     T_camera_pregrasp[:3, 3] -= options.standoff * T_camera_hand[:3, 2]
@@ -382,15 +387,16 @@ def plan_to_camera(metric: MetricContour, view: ApproachView | None, grasp_heigh
     """(n, 3) float: camera-frame points of a plan's frame's points (n, 2): in the contour's plane for a top-down
     plan (``view`` None), at ``grasp_height`` in front of the reference plane (where the fingertips close) for a side
     or tilted one (:attr:`ImageGraspPlan.view`)."""
+    frame = plan_metric(metric, view)
+    points = frame.to_camera(xy)
+    return points if view is None else points - grasp_height * frame.R_camera_plane[:, 2]
+
+
+def plan_metric(metric: MetricContour, view: ApproachView | None) -> MetricContour:
+    """The planning frame of a plan: ``metric`` for a top-down one (``view`` None); else ``metric`` with the approach
+    frame of ``view`` as its planning frame (its contour the outline seen along it, its origin the view's)."""
     if view is None:
-        return metric.to_camera(xy)
-    xy = np.asarray(xy, dtype=float).reshape(-1, 2)
-    plane = view.to_plane(np.c_[xy, np.full(len(xy), -grasp_height)])
-    return metric.origin + plane @ metric.R_camera_plane.T
-
-
-def _view_metric(metric: MetricContour, view: ApproachView) -> MetricContour:
-    """``metric`` with the approach frame of ``view`` as its planning frame (its contour the outline seen along it)."""
+        return metric
     return replace(metric, contour_xy=view.contour_xy, R_camera_plane=metric.R_camera_plane @ view.R_plane_view,
                    origin=metric.origin + metric.R_camera_plane @ view.origin)
 

@@ -170,9 +170,7 @@ def approach_to_dict(result) -> dict:
             "elevation": approach.elevation, "azimuth": approach.azimuth,
             "direction_camera": result.T_camera_hand[:3, 2].tolist()}
     if result.view is not None:
-        metric, view = result.metric, result.view
-        data["R_camera_view"] = (metric.R_camera_plane @ view.R_plane_view).tolist()
-        data["origin_camera"] = (metric.origin + metric.R_camera_plane @ view.origin).tolist()
+        data["R_camera_view"], data["origin_camera"] = result.frame.R_camera_plane.tolist(), result.frame.origin.tolist()
     return data
 
 
