@@ -57,13 +57,12 @@ class GraspMemory:
         approached as ``approach`` says ("top", "side" or "tilted"; of the latter two only the kind is kept)."""
         x, y, yaw = validation.finite_array("pose", pose, (3,), error=PlannerError)
         approach = validation.choice("approach", approach, APPROACH_KINDS, error=PlannerError)
-        kinds = (*self.kinds, approach)[-MAX_MEMORY_FAILURES:]
-        if approach != "top":
-            return GraspMemory(self.failures[-kinds.count("top"):] if "top" in kinds else (), kinds)
-        centre, angle = object_frame(contour_xy)
-        local = _rotation(-angle) @ (np.array([x, y]) - centre)
-        kept = (*self.failures, (float(local[0]), float(local[1]), float(_wrapped(yaw - angle))))
-        return GraspMemory(kept[-kinds.count("top"):], kinds)
+        kinds, failures = (*self.kinds, approach)[-MAX_MEMORY_FAILURES:], self.failures
+        if approach == "top":
+            centre, angle = object_frame(contour_xy)
+            local = _rotation(-angle) @ (np.array([x, y]) - centre)
+            failures = (*failures, (float(local[0]), float(local[1]), float(_wrapped(yaw - angle))))
+        return GraspMemory(failures[len(failures) - kinds.count("top"):], kinds)  # the top-down ones still kept
 
     def failures_by_kind(self) -> dict[str, int]:
         """How many grasps failed per kind of approach."""
