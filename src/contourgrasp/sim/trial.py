@@ -344,13 +344,18 @@ def _surroundings(lab, mask) -> np.ndarray:
 def _carry_away(scene) -> None:
     """The closed hand, at its height, carried ``CARRY_AWAY`` (m) along the world's y in ``CARRY_TIME`` s, out of the
     camera's view, with what it holds: where a robot shows the camera the table before it tries again."""
-    start = scene.hand_base()
-    aside = np.zeros_like(start)
-    aside[1] = CARRY_AWAY
-    steps = max(1, round(CARRY_TIME / scene.model.opt.timestep))
+    _move_closed(scene, scene.hand_base(), 1, CARRY_AWAY, CARRY_TIME)
+
+
+def _move_closed(scene, start, joint: int, distance: float, duration: float) -> None:
+    """Move the closed hand's base from ``start`` by ``distance`` (m) along its ``joint`` (0-2: world x, y, z) in
+    ``duration`` s, smoothly (smoothstep)."""
+    offset = np.zeros(len(start))
+    offset[joint] = distance
+    steps = max(1, round(duration / scene.model.opt.timestep))
     for k in range(steps):
         u = (k + 1) / steps
-        scene.command(start + aside * (u * u * (3 - 2 * u)), 1.0)
+        scene.command(start + offset * (u * u * (3 - 2 * u)), 1.0)
         scene.step()
 
 
@@ -687,13 +692,7 @@ def _lift_and_hold(scene, base, execution):
     """Lift smoothly, hold; the object's rise (end of hold, end of lift) and its largest drift in the hand."""
     dt = scene.model.opt.timestep
     z0 = scene.object_com()[2]
-    steps = max(1, round(execution.lift_height / execution.lift_speed / dt))
-    up = np.zeros(len(base))
-    up[2] = execution.lift_height
-    for k in range(steps):
-        u = (k + 1) / steps
-        scene.command(base + up * (u * u * (3 - 2 * u)), 1.0)  # smoothstep
-        scene.step()
+    _move_closed(scene, base, 2, execution.lift_height, execution.lift_height / execution.lift_speed)
     lifted = scene.object_com()[2] - z0
     reference = _in_palm(scene)
     drift = 0.0
