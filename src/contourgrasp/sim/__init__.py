@@ -9,6 +9,7 @@
 * :mod:`~contourgrasp.sim.clutter` -- scenes of several objects: clutter on the table, a bin, tilted cameras
 * :mod:`~contourgrasp.sim.render` -- RGB-D pictures by ray casting
 * :mod:`~contourgrasp.sim.trial` -- grasp execution and trials
+* :mod:`~contourgrasp.sim.detect` -- telling a failed grasp from a new picture (`seen_lifted`)
 * :mod:`~contourgrasp.sim.measure` -- fingertip paths against the preset
 * :mod:`~contourgrasp.sim.planners` -- the library's pipeline as trial planners, and two baselines
 * :mod:`~contourgrasp.sim.bench` -- Table 4.4 as a benchmark (``contourgrasp bench``), with its figures
