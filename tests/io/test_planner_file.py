@@ -58,6 +58,9 @@ def test_a_file_round_trips_its_options(tmp_path):
     ('name = "x"\nlow_objects = 1', "low_objects"),
     ('name = "x"\nmax_imbalance = "hands"', "max_imbalance"),
     ('name = "x"\nmax_imbalance = 1.5', "max_imbalance"),
+    ('name = "x"\napproaches = "front"', "approaches: approaches must be one of"),
+    ('name = "x"\napproaches = "top+top"', "approaches: approaches names a kind twice"),
+    ('name = "x"\napproaches = 3', "approaches"),
 ])
 def test_bad_files_name_the_field(text, field):
     with pytest.raises(PlannerFileError, match=f"mine.toml: {field}"):

@@ -104,6 +104,17 @@ class _PlannerSchema(BaseModel):
     def _slice(cls, value):
         return _toml_files.flag_or_word(value, ("unbalanced", "hand"))
 
+    @field_validator("approaches")
+    @classmethod
+    def _approaches(cls, value):
+        """Kinds joined by ``+``, each once: the search's own check, so that the refusal names the file."""
+        from ..synthesis.options import check_approaches
+
+        try:
+            return check_approaches(value)
+        except PlannerError as err:
+            raise ValueError(str(err)) from None
+
     @field_validator("grasp_height", mode="before")
     @classmethod
     def _height(cls, value):
