@@ -430,3 +430,9 @@ def test_a_bench_prints_no_trials_perception_warnings(tmp_path, capsys):
             "--out", str(tmp_path / "b")]
     assert main(argv) == 0
     assert "warning" not in capsys.readouterr().err  # each would say the camera is tilted 45 deg
+
+
+def test_bench_clear_protocol_needs_a_scene_of_several_objects(tmp_path, capsys):
+    code, out, err = run(capsys, "bench", "--protocol", "clear", "--objects", "can", "--out", tmp_path / "b")
+    assert code == 2 and err.startswith("contourgrasp: error: protocol 'clear' needs a scene of several objects")
+    assert not (tmp_path / "b").exists()

@@ -318,6 +318,10 @@ def _add_bench_parser(sub) -> None:
     bench.add_argument("--attempts", type=_positive_int, default=1,
                        help="at most this many attempts per trial: a failure told from a new picture, the next "
                             "plan avoiding the grasps that failed (1-5; default 1; docs/regrasp.md)")
+    bench.add_argument("--protocol", choices=("trials", "clear"), default="trials",
+                       help="trials: each trial grasps its target (default); clear: with --scene clutter or bin, each "
+                            "trial picks until the table is empty, nothing can be planned or two attempts in a row "
+                            "fail (docs/bench.md, 'Clearing a table')")
 
 
 def _add_calibrate_parser(sub) -> None:
@@ -616,7 +620,7 @@ def _bench(args) -> int:
     setup = bench.Bench(objects=objects, planners=planners, trials=args.trials, seed=args.seed, hand=hand,
                         sensor=args.sensor, tilt=None if args.tilt is None else math.radians(args.tilt),
                         robot=args.robot_in_view, splits=splits, hand_model=mounted,
-                        scene_kind=args.scene, attempts=args.attempts)
+                        scene_kind=args.scene, attempts=args.attempts, protocol=args.protocol)
     journal, done = bench.resume(out, setup) if args.resume is not None else (None, ())
     with bench.executor(setup, workers=args.workers, ray=args.ray is not None, address=args.ray or None) as run:
         if journal is None:

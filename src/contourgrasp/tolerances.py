@@ -232,6 +232,10 @@ DETECT_COLOUR = 12.0
 DETECT_CONTRAST = 30.0
 #: ... lower than its former top plus this (m): held at the lift's height (0.15 m) it stands higher.
 DETECT_RISE = 0.05
+#: A closed hand holds something when one of its finger joints reads at least this far (rad, or m for a slide) from
+#: where it stops closed on nothing: measured on clutter runs, an empty hand's joints lie within 0.0003 of it and a
+#: held object's stop at least 0.02 short (sim.detect.fingers_hold).
+HOLD_READING = 0.01
 #: At most this many attempts per trial (bounds the work a bench can ask for).
 MAX_ATTEMPTS = 5
 

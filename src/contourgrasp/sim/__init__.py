@@ -9,7 +9,8 @@
 * :mod:`~contourgrasp.sim.clutter` -- scenes of several objects: clutter on the table, a bin, tilted cameras
 * :mod:`~contourgrasp.sim.render` -- RGB-D pictures by ray casting
 * :mod:`~contourgrasp.sim.trial` -- grasp execution and trials
-* :mod:`~contourgrasp.sim.detect` -- telling a failed grasp from a new picture (`seen_lifted`)
+* :mod:`~contourgrasp.sim.clearing` -- clearing a table: the clutter-removal protocol (``bench --protocol clear``)
+* :mod:`~contourgrasp.sim.detect` -- telling a failed grasp from a new picture and the hand's joints (`told_lifted`)
 * :mod:`~contourgrasp.sim.measure` -- fingertip paths against the preset
 * :mod:`~contourgrasp.sim.planners` -- the library's pipeline as trial planners, and two baselines
 * :mod:`~contourgrasp.sim.bench` -- Table 4.4 as a benchmark (``contourgrasp bench``), with its figures
@@ -39,6 +40,7 @@ from .scene import ROBOT_ARM, SR300, Bin, Camera, Placement, Scene, Workspace, b
 from .clutter import SCENE_KINDS, Arrangement, arrange, build_clutter, target_pixel
 from .trial import (DROPPED, FAILURE_CAUSES, HIT, MISSED, NO_PLAN, PUSHED, SLIPPED, STRUCK, Execution, GraspOutcome,
                     TrialRecord, execute_grasp, hand_pose_from_matrix, pose_matrix, run_trial, scripted_grasp)
+from .clearing import run_clearing
 
 __all__ = [
     "procedural_object",
@@ -47,5 +49,5 @@ __all__ = [
     "HandModel", "Intrinsics", "MISSED", "NO_PLAN", "ObjectSpec", "PUSHED", "Part", "Placement", "SLIPPED", "SR300", "STRUCK",
     "Scene", "THESIS_OBJECTS", "TIMINGS", "TrialRecord", "Workspace", "build_hand", "build_scene", "derive_body", "execute_grasp",
     "fingertip_path_error", "fingertip_paths", "hand_pose_from_matrix", "mesh_object", "object_spec", "object_truth",
-    "pose_matrix", "render", "render_view", "run_trial", "scripted_grasp", "sensor_named", "tilted_view",
+    "pose_matrix", "render", "render_view", "run_clearing", "run_trial", "scripted_grasp", "sensor_named", "tilted_view",
 ]

@@ -244,11 +244,17 @@ def target_pixel(scene: Scene) -> tuple[int, int]:
     first in image order on ties); the projection of the target's centre of
     mass when nothing of it is in view.
     """
-    mask = truth_labels(scene) == 1
+    mask = truth_labels(scene) == scene.target + 1
     if not mask.any():
         eye, R_world_camera = scene.view
         u, v = scene.camera.intrinsics.project(((scene.object_com() - eye) @ R_world_camera)[None])[0]
         return int(round(u)), int(round(v))
+    return deepest_pixel(mask)
+
+
+def deepest_pixel(mask) -> tuple[int, int]:
+    """The pixel (u, v) of a non-empty (H, W) bool ``mask`` farthest from its edge (a distance transform's maximum,
+    the first in image order on ties)."""
     distance = cv2.distanceTransform(np.pad(mask, 1).astype(np.uint8), cv2.DIST_L2, 5)[1:-1, 1:-1]
     v, u = np.unravel_index(int(np.argmax(distance)), distance.shape)
     return int(u), int(v)

@@ -1,8 +1,11 @@
-"""Telling a failed grasp from a picture: whether the object still stands where it stood (:func:`seen_lifted`).
+"""Telling a failed grasp as a robot tells it: from a new picture and from the hand's joint readings.
 
 After an attempt the closed hand carries what it holds out of the camera's view
-(:func:`contourgrasp.sim.trial.run_trial` with several attempts) and a new picture is taken; these tests
-read it as a robot's camera would, not the simulator's truth (docs/regrasp.md).
+(:func:`contourgrasp.sim.trial.run_trial` with several attempts) and a new picture is taken:
+:func:`seen_lifted` reads it as a robot's camera would -- whether the object still stands where it stood.
+:func:`fingers_hold` reads the closed hand's joints as its encoders would -- whether a finger stopped
+short of where it closes on nothing. An attempt is told a success when both say so (:func:`told_lifted`);
+neither reads the simulator's truth (docs/regrasp.md).
 """
 
 from __future__ import annotations
@@ -13,7 +16,22 @@ import numpy as np
 from .. import perception
 from ..errors import SegmentationError
 from ..perception.table import heights
-from ..tolerances import DETECT_COLOUR, DETECT_CONTRAST, DETECT_REACH, DETECT_RISE, DETECT_SHARE, LIGHTNESS_WEIGHT, MIN_HEIGHT
+from ..tolerances import (DETECT_COLOUR, DETECT_CONTRAST, DETECT_REACH, DETECT_RISE, DETECT_SHARE, HOLD_READING,
+                          LIGHTNESS_WEIGHT, MIN_HEIGHT)
+
+
+def told_lifted(planned, before, after, readings, free_closure, *, anywhere: bool = False) -> bool:
+    """Whether an attempt is told a success: the new picture says its object was lifted (:func:`seen_lifted`) and
+    the hand's joints say it holds something (:func:`fingers_hold`)."""
+    return fingers_hold(readings, free_closure) and seen_lifted(planned, before, after, anywhere=anywhere)
+
+
+def fingers_hold(readings, free_closure) -> bool:
+    """Whether a closed hand holds something: one of its finger joints ``readings`` (j,) reads at least
+    ``tolerances.HOLD_READING`` from ``free_closure`` (j,), where it stops closed on nothing -- a finger on an
+    object stops short. A hand without finger joints is never told empty."""
+    readings, free = np.asarray(readings, dtype=float), np.asarray(free_closure, dtype=float)
+    return not readings.size or bool(np.max(np.abs(readings - free)) >= HOLD_READING)
 
 
 def seen_lifted(planned, before, after, *, anywhere: bool = False) -> bool:

@@ -28,7 +28,7 @@ import numpy as np
 
 from ..errors import SimulationError
 from ..perception import Intrinsics
-from .scene import R_WORLD_CAMERA, Scene, mujoco
+from .scene import R_WORLD_CAMERA, Scene, mujoco, object_bodies
 
 #: Geom groups the camera sees: table and objects (0) and objects' drawn meshes (1), not the hand (2)
 #: nor collision-only pieces (3).
@@ -226,7 +226,7 @@ def object_truth(scene: Scene, view=None) -> tuple[np.ndarray, np.ndarray]:
     intr = scene.camera.intrinsics
     eye, R_world_camera = _view(scene, view)
     _, _, geom = _cast(scene, eye, R_world_camera, intr, False, VIEW_RANGE)
-    obj = scene.model.body("object").id
+    obj = scene.object_body
     seen = (geom >= 0) & (scene.model.geom_bodyid[np.maximum(geom, 0)] == obj)
     rays = pixel_rays(intr).reshape(-1, 3) @ R_world_camera.T
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -248,16 +248,16 @@ def object_truth(scene: Scene, view=None) -> tuple[np.ndarray, np.ndarray]:
 def truth_labels(scene: Scene, view=None) -> np.ndarray:
     """(H, W) int: which object each pixel of :func:`render`'s picture (same ``view``) sees, hand never shown.
 
-    0 the table, the bin's floor (or nothing), ``1`` the target (body ``object``), ``k + 2`` the
-    neighbour ``k``, :data:`BIN_LABEL` the bin's walls. Exact: the geom each pixel's ray meets first.
+    0 the table, the bin's floor (or nothing), ``k + 1`` the object ``k`` of :attr:`Scene.objects
+    <contourgrasp.sim.scene.Scene.objects>` (``1`` the target as built, body ``object``; ``k + 2`` the
+    neighbour ``k``), :data:`BIN_LABEL` the bin's walls. Exact: the geom each pixel's ray meets first.
     """
     eye, R_world_camera = _view(scene, view)
     _, _, geom = _cast(scene, eye, R_world_camera, scene.camera.intrinsics, False, VIEW_RANGE)
     model = scene.model
     body_label = np.zeros(model.nbody, dtype=int)
-    body_label[model.body("object").id] = 1
-    for k in range(len(scene.neighbours)):
-        body_label[model.body(f"neighbour_{k}").id] = k + 2
+    for k, name in enumerate(object_bodies(len(scene.objects))):
+        body_label[model.body(name).id] = k + 1
     geom_label = body_label[model.geom_bodyid]
     if scene.bin is not None:
         geom_label[[model.geom(name).id for name, _, _ in scene.bin.geoms()[1:]]] = BIN_LABEL

@@ -46,6 +46,7 @@ figures, and the bench before and after: ``docs/bench.md``, "The friction's cree
 from __future__ import annotations
 
 import contextlib
+import copy
 import math
 import os
 from dataclasses import dataclass
@@ -92,6 +93,11 @@ SOLVER = solver_option()
 ROLLING = 0.0005
 #: Rotation from the camera optical frame to the world frame.
 R_WORLD_CAMERA = np.diag([1.0, -1.0, -1.0])
+#: Where :meth:`Scene.remove` parks an object (world x, y, z, m; the next one a metre farther along x), far from
+#: the table and every camera's view, and the damping (N s/m) of its free joint that holds it there.
+REMOVED_AT, REMOVED_DAMPING = (10.0, 10.0, -5.0), 1e6
+#: Seconds the hand closes on nothing for :meth:`Scene.free_closure`.
+FREE_CLOSURE_TIME = 1.5
 #: Height from which the neighbours of a scene of several objects are dropped, m.
 DROP_HEIGHT = 0.003
 #: Half extents (x, y) of the table top, m.
@@ -220,25 +226,33 @@ class Scene:
     kind : str
         ``"single"``, ``"clutter"`` or ``"bin"`` (:mod:`contourgrasp.sim.clutter`).
     neighbours : tuple of ObjectSpec
-        The other objects, bodies ``neighbour_0``, ``neighbour_1``, ...
+        The other objects as built, bodies ``neighbour_0``, ``neighbour_1``, ...
     bin : Bin or None
     view : (eye, R_world_camera) or None
         Where the planner's picture is taken from when not from ``camera`` (a tilted camera).
+    target : int
+        Which object is the target, in :attr:`objects`' order (0, body ``object``, until :meth:`retarget`).
+
+    Every object but the target and those taken out (:meth:`remove`) is a neighbour: the hand must not touch it.
     """
 
     def __init__(self, model, data, obj: ObjectSpec, hand: HandModel, camera: Camera, placement: Placement, *,
                  kind: str = "single", neighbours: tuple[ObjectSpec, ...] = (), bin: Bin | None = None, view=None):
         self.model, self.data = model, data
-        self.object, self.hand, self.camera, self.placement = obj, hand, camera, placement
+        self.hand, self.camera, self.placement = hand, camera, placement
         self.kind, self.neighbours, self.bin, self.view = kind, tuple(neighbours), bin, view
-        self._object_body = model.body("object").id
-        self._neighbour_bodies = np.array([model.body(f"neighbour_{k}").id for k in range(len(self.neighbours))],
-                                          dtype=int)
+        self.objects = (obj, *self.neighbours)
+        self._bodies = np.array([model.body(name).id for name in object_bodies(len(self.objects))], dtype=int)
+        self._present = np.ones(len(self.objects), dtype=bool)
+        self.target = 0
         self._palm = model.body("palm").id
         joints = BASE_JOINTS + (WRIST_JOINTS if hand.design.wrist else ())
         self._base_qpos = np.array([model.joint(j).qposadr[0] for j in joints])
         self._base_ctrl = np.array([model.actuator(j).id for j in joints])
         self._base_dofs = np.array([model.joint(j).dofadr[0] for j in joints])
+        below_palm = [j for j in range(model.njnt) if _descends(model, model.jnt_bodyid[j], self._palm)]
+        self._finger_qpos = model.jnt_qposadr[below_palm]
+        self._free_closure = None
         synergy = getattr(hand, "synergy", None)  # a mounted hand model (handmodels.mount) closes many actuators
         self._closing = synergy(model) if synergy else (np.array([model.actuator("flexion").id]), np.zeros(1),
                                                         np.ones(1))
@@ -249,13 +263,68 @@ class Scene:
     def time(self) -> float:
         return float(self.data.time)
 
+    @property
+    def object(self) -> ObjectSpec:
+        """The target."""
+        return self.objects[self.target]
+
+    @property
+    def object_body(self) -> int:
+        """The target's MuJoCo body id."""
+        return int(self._bodies[self.target])
+
+    @property
+    def _neighbour_bodies(self) -> np.ndarray:
+        others = self._present.copy()
+        others[self.target] = False
+        return self._bodies[others]
+
+    @property
+    def present(self) -> tuple[int, ...]:
+        """The objects (indices into :attr:`objects`) still in the scene: none taken out by :meth:`remove`."""
+        return tuple(int(k) for k in np.flatnonzero(self._present))
+
+    def retarget(self, index: int) -> None:
+        """Make object ``index`` (of :attr:`objects`, present) the target; the others present are its neighbours."""
+        if index not in self.present:
+            raise SimulationError(f"object {index} is not in the scene: it has {len(self.objects)} objects, "
+                                  f"present {list(self.present)}")
+        self.target = index
+
+    def remove(self, index: int) -> None:
+        """Take object ``index`` out of the scene: parked far from the table (``REMOVED_AT``, a metre apart),
+        held there by its free joint's damping, never seen or touched again -- a robot put it in a box."""
+        body = int(self._bodies[index])
+        joint = self.model.body_jntadr[body]
+        qpos, dofs = self.model.jnt_qposadr[joint], self.model.jnt_dofadr[joint] + np.arange(6)
+        self.data.qpos[qpos:qpos + 7] = [REMOVED_AT[0] + index, *REMOVED_AT[1:], 1.0, 0.0, 0.0, 0.0]
+        self.data.qvel[dofs] = 0.0
+        self.model.dof_damping[dofs] = REMOVED_DAMPING
+        self._present[index] = False
+        with mujoco_warnings():
+            mujoco.mj_forward(self.model, self.data)
+
+    def on_support(self) -> np.ndarray:
+        """(k,) bool: per object present (:attr:`present`' order), whether its centre of mass is over the table
+        (the bin's floor, in a bin) and above its top."""
+        return self._supported(self.coms())
+
+    def coms(self) -> np.ndarray:
+        """(k, 3) float: the centres of mass of the objects present (:attr:`present`' order), world."""
+        return self.data.xipos[self._bodies[self._present]].copy()
+
+    def _supported(self, coms) -> np.ndarray:
+        """(k,) bool: whether each centre of mass (k, 3) is over the table (the bin's floor) and above its top."""
+        over = self.bin.contains(coms[:, :2]) if self.bin else np.all(np.abs(coms[:, :2]) < TABLE_HALF, axis=1)
+        return over & (coms[:, 2] > 0.0)
+
     def object_position(self) -> np.ndarray:
         """(3,) float: the object's body origin (resting-face centre at placement), world."""
-        return self.data.xpos[self._object_body].copy()
+        return self.data.xpos[self.object_body].copy()
 
     def object_com(self) -> np.ndarray:
         """(3,) float: the object's centre of mass, world."""
-        return self.data.xipos[self._object_body].copy()
+        return self.data.xipos[self.object_body].copy()
 
     def neighbour_coms(self) -> np.ndarray:
         """(k, 3) float: the neighbours' centres of mass, world."""
@@ -275,8 +344,7 @@ class Scene:
         centre of mass is no longer over the table (over the bin's floor, in a bin) or below its top.
         """
         now = self.neighbour_coms()
-        support = self.bin.contains(now[:, :2]) if self.bin else np.all(np.abs(now[:, :2]) < TABLE_HALF, axis=1)
-        gone = (now[:, 2] - np.asarray(rest)[:, 2] > NEIGHBOUR_LIFT) | ~support | (now[:, 2] < 0.0)
+        gone = (now[:, 2] - np.asarray(rest)[:, 2] > NEIGHBOUR_LIFT) | ~self._supported(now)
         return [int(k) for k in np.flatnonzero(gone)]
 
     def to_reference(self, T_view_hand) -> tuple[float, float, float, float]:
@@ -295,8 +363,8 @@ class Scene:
 
     def object_points(self) -> np.ndarray:
         """(p, 3) float: surface points of the object's collision parts where it lies now, world."""
-        rotation = self.data.xmat[self._object_body].reshape(3, 3)
-        return self.object.points() @ rotation.T + self.data.xpos[self._object_body]
+        rotation = self.data.xmat[self.object_body].reshape(3, 3)
+        return self.object.points() @ rotation.T + self.data.xpos[self.object_body]
 
     def palm_pose(self) -> tuple[np.ndarray, np.ndarray]:
         """World position (3,) and rotation (3, 3) of the hand frame."""
@@ -306,6 +374,26 @@ class Scene:
         """(4,) or (6,) float: the hand base's joints now (x, y, z of the hand-frame origin, world; yaw; with a wrist
         tilt and roll), as :meth:`command` takes them."""
         return np.array(self.data.qpos[self._base_qpos], dtype=float)
+
+    def finger_readings(self) -> np.ndarray:
+        """(j,) float: the hand's finger joints now (every joint below the palm), as a real hand's encoders read them."""
+        return self.data.qpos[self._finger_qpos].copy()
+
+    def free_closure(self) -> np.ndarray:
+        """(j,) float: :meth:`finger_readings` of the hand closed on nothing -- closed for ``FREE_CLOSURE_TIME`` s far
+        above the table, in a copy of the scene (computed once)."""
+        if self._free_closure is None:
+            data = copy.copy(self.data)
+            base = self.hand_base()
+            base[2] = PARK_HEIGHT
+            data.qpos[self._base_qpos], data.qvel[:] = base, 0.0
+            data.ctrl[self._base_ctrl] = base
+            actuators, _, closed = self._closing
+            data.ctrl[actuators] = closed
+            with mujoco_warnings():
+                mujoco.mj_step(self.model, data, nstep=round(FREE_CLOSURE_TIME / self.model.opt.timestep))
+            self._free_closure = data.qpos[self._finger_qpos].copy()
+        return self._free_closure.copy()
 
     def set_hand(self, x: float, y: float, z: float, yaw: float, closing: float = 0.0, *, tilt: float = 0.0,
                  roll: float = 0.0) -> None:
@@ -354,7 +442,9 @@ class Scene:
 
     def _fastest(self) -> float:
         """The largest speed of the object's and the neighbours' free joints, m/s (a turn rate times ``REST_RADIUS``)."""
-        bodies = np.r_[self._object_body, self._neighbour_bodies].astype(int)
+        bodies = self._bodies[self._present]
+        if not len(bodies):
+            return 0.0
         dofs = np.concatenate([self.model.jnt_dofadr[self.model.body_jntadr[b]] + np.arange(6) for b in bodies])
         speeds = self.data.qvel[dofs].reshape(-1, 2, 3)
         return float(max(np.linalg.norm(speeds[:, 0], axis=1).max(),
@@ -364,6 +454,15 @@ class Scene:
     def unstable(self) -> bool:
         """Whether MuJoCo found NaN, infinite or huge accelerations (and reset the state) at some step."""
         return self.data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number > 0
+
+
+def _descends(model, body: int, ancestor: int) -> bool:
+    """Whether ``body`` lies strictly below ``ancestor`` in the model's tree."""
+    while body != 0:
+        body = model.body_parentid[body]
+        if body == ancestor:
+            return True
+    return False
 
 
 def base_angles(R_world_hand) -> tuple[float, float, float]:
@@ -462,12 +561,13 @@ def scene_xml(obj: ObjectSpec, hand: HandModel, placement: Placement, *, neighbo
     that much lower; ``robot`` adds the arm of :data:`ROBOT_ARM` (geoms ``robot_0``, ...).
     """
     assets = []
+    names = object_bodies(1 + len(neighbours))
     bodies = [_body_xml("object", obj, placement, assets, z=0.001)]
-    bodies += [_body_xml(f"neighbour_{k}", o, p, assets, z=DROP_HEIGHT) for k, (o, p) in enumerate(neighbours)]
+    bodies += [_body_xml(name, o, p, assets, z=DROP_HEIGHT) for name, (o, p) in zip(names[1:], neighbours)]
     statics = [] if bin is None else [_box_xml(name, size, pos, bin.rgba) for name, size, pos in bin.geoms()]
     statics += _robot_xml() if robot else []
     table_z = -0.02 - (bin.floor if bin is not None else 0.0)
-    pairs = _pairs([("object", obj), *((f"neighbour_{k}", o) for k, (o, _) in enumerate(neighbours))], hand, bin)
+    pairs = _pairs(list(zip(names, [obj, *(o for o, _ in neighbours)])), hand, bin)
     return f"""<mujoco model="contourgrasp-sim">
   <compiler angle="radian" autolimits="true"/>
   {SOLVER}
@@ -490,6 +590,11 @@ def scene_xml(obj: ObjectSpec, hand: HandModel, placement: Placement, *, neighbo
     {hand.actuator_xml()}
   </actuator>
 </mujoco>"""
+
+
+def object_bodies(count: int) -> tuple[str, ...]:
+    """The body names of a scene's ``count`` objects: ``object`` (built as the target), ``neighbour_0``, ..."""
+    return ("object", *(f"neighbour_{k}" for k in range(count - 1)))
 
 
 def _body_xml(name: str, obj: ObjectSpec, placement: Placement, assets: list[str], *, z: float) -> str:

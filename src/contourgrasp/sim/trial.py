@@ -76,7 +76,7 @@ from ..synthesis import GraspMemory
 from ..tolerances import MAX_ATTEMPTS
 from ..validation import integer
 from .clutter import build_clutter, target_pixel
-from .detect import seen_lifted
+from .detect import told_lifted
 from .tendon_hand import HandDesign
 from .render import DEFAULT_SENSOR, Sensor, render, tilted_view
 from .scene import R_WORLD_CAMERA, Camera, Scene, Workspace, base_angles, build_scene
@@ -196,8 +196,14 @@ class TrialRecord:
         Seconds of wall time for the whole trial (scene, picture, plan, simulation).
     outcomes, detected : tuple of bool
         With several attempts (:func:`run_trial`'s ``attempts``), per attempt made: whether it truly
-        succeeded, and whether the new frame after it said so (:func:`seen_lifted`); empty with one.
+        succeeded, and whether it was told a success -- the new frame after it and the hand's joint readings
+        (:func:`~contourgrasp.sim.detect.told_lifted`); empty with one.
         The other fields are the last attempt's, ``plan_time`` the attempts' sum.
+    scene_objects, cleared : int or None
+        Of a run clearing a table (:func:`~contourgrasp.sim.clearing.run_clearing`): the objects in the
+        scene, and those it cleared; None otherwise.
+    ended : str or None
+        How a clearing run ended (:data:`~contourgrasp.sim.clearing.ENDINGS`); None otherwise.
     """
 
     object: str
@@ -218,6 +224,9 @@ class TrialRecord:
     wall_time: float = field(compare=False)
     outcomes: tuple[bool, ...] = ()
     detected: tuple[bool, ...] = ()
+    scene_objects: int | None = None
+    cleared: int | None = None
+    ended: str | None = None
 
 
 def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finger-linear",
@@ -228,11 +237,12 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
     """Place the object (seeded), take an RGB-D picture, plan, execute, and record the outcome.
 
     With ``attempts`` above 1, a failure is told as a real robot would tell it -- a new picture after
-    the hold, in which the object still stands where it stood (:func:`seen_lifted`), not the
+    the hold, in which the object still stands where it stood, or the closed hand's joints at the
+    positions they reach on nothing (:func:`~contourgrasp.sim.detect.told_lifted`), not the
     simulator's truth -- and then the hand opens and leaves, the scene settles as it is, a new
     picture is taken and the planner tries again, remembering the grasps that failed (its ``plan``
-    takes ``memory``: :class:`~contourgrasp.synthesis.GraspMemory`), until a picture says the object
-    was lifted or ``attempts`` were made. The record is the last attempt's, with every attempt's
+    takes ``memory``: :class:`~contourgrasp.synthesis.GraspMemory`), until an attempt is told a
+    success or ``attempts`` were made. The record is the last attempt's, with every attempt's
     true and told outcome (``outcomes``, ``detected``).
 
     Parameters
@@ -291,7 +301,7 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
         scene.view = tilted_view(tilt, camera.height)
     memory, outcomes, detected, plan_time = GraspMemory(), [], [], 0.0
     for attempt in range(attempts):
-        rgb, depth = render(scene, sensor=sensor, seed=seed if attempt == 0 else _noise_seed(seed, attempt, 0))
+        rgb, depth = render(scene, sensor=sensor, seed=seed if attempt == 0 else noise_seed(seed, attempt, 0))
         fields, plan_error, planned, spent = _attempt(scene, planner, rgb, depth, camera, execution,
                                                       memory if attempts > 1 else None)
         plan_time += spent
@@ -301,9 +311,10 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
         if planned is None:  # no plan: nothing more to try
             detected.append(False)
             break
-        _carry_away(scene)
-        after = render(scene, sensor=sensor, seed=_noise_seed(seed, attempt, 1))
-        detected.append(seen_lifted(planned, (rgb, depth), after, anywhere=scene_kind == "single"))
+        carry_away(scene)
+        after = render(scene, sensor=sensor, seed=noise_seed(seed, attempt, 1))
+        detected.append(told_lifted(planned, (rgb, depth), after, scene.finger_readings(), scene.free_closure(),
+                                    anywhere=scene_kind == "single"))
         if detected[-1]:
             break
         memory = memory.with_failure(planned.metric.contour_xy, planned.pose, approach=planned.approach)
@@ -316,7 +327,7 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
                        detected=tuple(detected))
 
 
-def _carry_away(scene) -> None:
+def carry_away(scene) -> None:
     """The closed hand, at its height, carried ``CARRY_AWAY`` (m) along the world's y in ``CARRY_TIME`` s, out of the
     camera's view, with what it holds: where a robot shows the camera the table before it tries again."""
     _move_closed(scene, scene.hand_base(), 1, CARRY_AWAY, CARRY_TIME)
@@ -334,7 +345,7 @@ def _move_closed(scene, start, joint: int, distance: float, duration: float) -> 
         scene.step()
 
 
-def _noise_seed(seed: int, attempt: int, picture: int) -> int:
+def noise_seed(seed: int, attempt: int, picture: int) -> int:
     """The sensor noise's seed of a later picture of a trial: the attempt's, before (0) or after (1) it."""
     return int(np.random.SeedSequence([seed, attempt, picture]).generate_state(1)[0])
 
@@ -353,22 +364,27 @@ def _attempt(scene, planner, rgb, depth, camera: Camera, execution: Execution, m
                 planned = planner.plan(rgb, depth, camera.intrinsics, memory=memory, **target)
                 transform, approach_depth, planned_height = (planned.T_camera_hand, planned.approach_depth,
                                                              [planned.grasp_height])
-        if scene.view is not None and _vertical(scene, transform):
-            *pose, approach_depth = scene.to_reference(transform)
-            transform = pose_matrix(*pose, approach_depth)
-        plan_error = None
     except (NoFeasibleGrasp, InputError) as err:
-        plan_error, planned = str(err), None
+        return NO_PLAN_FIELDS, str(err), None, time.perf_counter() - planning
     spent = time.perf_counter() - planning
-    if plan_error is not None:
-        return ({"success": False, "cause": NO_PLAN, "fingers_in_contact": (), "first_contact": (), "push": 0.0,
-                 "lift": 0.0, "hold_drift": 0.0, "pose": None, "approach_depth": None, "grasp_height": None},
-                plan_error, None, spent)
     grasp_height = planned_height[0] if planned_height else None
+    return execute_planned(scene, transform, approach_depth, grasp_height, execution), None, planned, spent
+
+
+#: The outcome's fields of a trial without a plan.
+NO_PLAN_FIELDS = {"success": False, "cause": NO_PLAN, "fingers_in_contact": (), "first_contact": (), "push": 0.0,
+                  "lift": 0.0, "hold_drift": 0.0, "pose": None, "approach_depth": None, "grasp_height": None}
+
+
+def execute_planned(scene, transform, approach_depth: float, grasp_height: float | None, execution: Execution) -> dict:
+    """Execute a planner's answer on ``scene`` (a top-down pose planned in a tilted view from the reference
+    camera's frame, :meth:`~contourgrasp.sim.scene.Scene.to_reference`); the record's fields of its outcome."""
+    if scene.view is not None and _vertical(scene, transform):
+        *pose, approach_depth = scene.to_reference(transform)
+        transform = pose_matrix(*pose, approach_depth)
     outcome = asdict(execute_grasp(scene, transform, approach_depth, execution, grasp_height=grasp_height))
-    fields = {k: v for k, v in outcome.items() if k != "palm_depth"} | {
+    return {k: v for k, v in outcome.items() if k != "palm_depth"} | {
         "approach_depth": float(approach_depth), "grasp_height": None if grasp_height is None else float(grasp_height)}
-    return fields, None, planned, spent
 
 
 def with_wrist(planner, hand, design: HandDesign):
@@ -519,7 +535,7 @@ class _Probe:
         self.scene = scene
         self.hit = False
         self.obstacle_geoms = scene.obstacle_geoms()
-        self.object_geoms = np.flatnonzero(model.geom_bodyid == model.body("object").id)
+        self.object_geoms = np.flatnonzero(model.geom_bodyid == scene.object_body)
         self.finger_of = {}  # hand geom id -> finger index (-1: palm and posts)
         for name in scene.hand.geom_names():
             finger = next((i for i, f in enumerate(scene.hand.fingers) if name.startswith(f"{f.name}_")
@@ -628,7 +644,7 @@ def scripted_grasp(scene: Scene, kind: str = "good") -> tuple[np.ndarray, float]
     if kind not in ("good", "bad"):
         raise SimulationError(f"scripted grasp kind must be 'good' or 'bad', got {kind!r}")
     hand = scene.hand.hand
-    rotation_world = scene.data.xmat[scene.model.body("object").id].reshape(3, 3)
+    rotation_world = scene.data.xmat[scene.object_body].reshape(3, 3)
     axis = scene.camera.from_world(scene.camera.position + rotation_world[:, 0])[:2]
     yaw = math.atan2(axis[1], axis[0]) + (SCRIPTED_TILT if kind == "good" else 0.0)
     thumbs = np.array([f.required for f in hand.fingers])
@@ -649,6 +665,6 @@ def _rotate(point, yaw) -> np.ndarray:
 
 
 def _world_points(scene: Scene) -> np.ndarray:
-    body = scene.model.body("object").id
+    body = scene.object_body
     rotation = scene.data.xmat[body].reshape(3, 3)
     return scene.object.points() @ rotation.T + scene.data.xpos[body]

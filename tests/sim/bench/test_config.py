@@ -79,3 +79,21 @@ def test_a_scene_of_several_objects_draws_neighbours_from_the_targets_split():
     assert "hit a neighbour or the bin" not in Bench(objects=objects, trials=1).causes
     with pytest.raises(SimulationError, match="scene must be one of"):
         Bench(objects=objects, trials=1, scene_kind="heap")
+
+
+@pytest.mark.parametrize("options, message", [
+    ({"protocol": "heap", "scene_kind": "clutter"}, "protocol must be one of"),
+    ({"protocol": "clear"}, "protocol 'clear' needs a scene of several objects"),
+    ({"protocol": "clear", "scene_kind": "bin", "attempts": 3}, "attempts must be 1 with protocol 'clear'"),
+])
+def test_the_clearing_protocol_needs_a_scene_of_several_objects_and_makes_its_own_attempts(options, message):
+    with pytest.raises(SimulationError, match=message):
+        Bench(objects=thesis_objects(["can"]), trials=1, **options)
+
+
+def test_a_clearing_bench_clears_its_scenes():
+    bench = Bench(objects=thesis_objects(["can", "case"]), planners=("default",), trials=1, scene_kind="clutter",
+                  protocol="clear")
+    record = bench.run("default", bench.object("can"), 0)
+    assert record.scene_objects >= 2 and record.ended is not None and len(record.outcomes) >= 1
+    assert record.success == (record.cleared == record.scene_objects)

@@ -234,3 +234,19 @@ def test_fuzz_resume_reads_a_journal_or_names_its_line(tmp_path_factory):
             assert (folder / JOURNAL).read_bytes() == before
 
     check()
+
+
+def test_the_protocol_is_a_setting_only_when_clearing_and_a_run_s_counts_are_kept():
+    from dataclasses import replace
+
+    from contourgrasp.sim.bench import trial_to_dict
+    from contourgrasp.sim.bench.journal import _TrialLine
+
+    assert "protocol" not in settings(Bench(objects=thesis_objects(["can"]), planners=("paper",), trials=1))
+    clearing = Bench(objects=thesis_objects(["can"]), planners=("paper",), trials=1, scene_kind="bin", protocol="clear")
+    assert settings(clearing)["protocol"] == "clear"
+    result = BenchTrial("paper", 0, replace(TrialRecord(**RECORD), outcomes=(True, False), detected=(True, False),
+                                            scene_objects=3, cleared=1, ended="failed twice in a row"))
+    line = json.loads(json.dumps(trial_to_dict(result)))
+    _TrialLine.model_validate(line)
+    assert trial_from_dict(line) == result

@@ -193,3 +193,26 @@ def test_several_attempts_are_reported_first_within_and_as_told(tmp_path):
     assert "| default | all | 25 % (5–70) 1/4 | 50 % (15–85) 2/4 | 1.75 |" in table
     assert "| succeeded | 2 | 2 |" in table and "| failed | 0 | 3 |" in table
     assert "False success: 2 of 7 attempts (28.6 %)." in table
+
+
+def test_clearing_is_reported_per_attempt_per_object_and_by_its_end(tmp_path):
+    from dataclasses import replace
+
+    bench = Bench(objects=thesis_objects(["can", "case"]), planners=("default",), trials=2, scene_kind="clutter",
+                  protocol="clear")
+    runs = {("can", 0): ((True, True), 2, 2, "table cleared"), ("can", 1): ((True, False, False), 3, 1,
+                                                                              "failed twice in a row"),
+            ("case", 0): ((), 4, 0, "nothing to plan on"), ("case", 1): ((False, True, True, True), 3, 3,
+                                                                          "table cleared")}
+    results = []
+    for r in _split_results(bench, {"default": {"can": 0, "case": 0}}):
+        outcomes, objects, cleared, ended = runs[r.record.object, r.trial]
+        results.append(BenchTrial(r.planner, r.trial, replace(r.record, outcomes=outcomes, detected=outcomes,
+                                                              scene_objects=objects, cleared=cleared, ended=ended,
+                                                              success=cleared == objects)))
+    write_outputs(bench, results, tmp_path, wall_time=1.0)
+    table = (tmp_path / "table.md").read_text()
+    # 6 of 9 attempts lifted; 6 of 12 objects cleared; 9 attempts / 12 objects; 2 of 4 tables cleared
+    assert "| default | all | 67 % (35–88) 6/9 | 50 % (25–75) 6/12 | 0.75 | 50 % (15–85) 2/4 |" in table
+    assert "| default | 2 | 1 | 1 | 0 |" in table  # table cleared, nothing to plan on, failed twice, limit
+    assert "False success: 0 of 9 attempts (0.0 %)." in table and "Protocol `clear`" in table

@@ -9,6 +9,7 @@ from ...tolerances import MAX_ATTEMPTS, MAX_BENCH_TILT, MAX_BENCH_TRIALS, MAX_SE
 from ...hand import Hand
 from ...io.hand_file import load_hand
 from ...validation import bounded, choice, integer
+from ..clearing import ATTEMPTS_PER_OBJECT, run_clearing
 from ..clutter import SCENE_KINDS
 from ..tendon_hand import build_hand
 from ..objects import THESIS_OBJECTS, ObjectSpec, object_spec
@@ -23,6 +24,9 @@ from ..ycb import OBJECT_SETS, load_object, object_names
 THESIS_SUCCESS = {"can": 0.8, "case": 0.4, "bottle": 0.7, "stone1": 0.2, "stone2": 0.6}
 #: Column headings of Table 4.4 for the simulated objects.
 LABELS = {"can": "can", "case": "glasses case", "bottle": "bottle", "stone1": "stone 1", "stone2": "stone 2"}
+#: What a bench's trial is: one grasp of a target (``trials``), or clearing its scene (``clear``,
+#: :mod:`contourgrasp.sim.clearing`).
+PROTOCOLS = ("trials", "clear")
 #: Short failure causes for the trial tables.
 SHORT_CAUSES = {NO_PLAN: "no plan", STRUCK: "struck", MISSED: "missed", PUSHED: "pushed", SLIPPED: "slipped",
                 DROPPED: "dropped", HIT: "hit"}
@@ -68,6 +72,10 @@ class Bench:
     attempts : int
         At most this many attempts per trial, a failure told from a new picture and the next plan
         avoiding the grasps that failed (:func:`~contourgrasp.sim.trial.run_trial`).
+    protocol : {"trials", "clear"}
+        ``trials``: each trial grasps its target (:func:`~contourgrasp.sim.trial.run_trial`); ``clear``
+        (``clutter`` and ``bin`` scenes, one attempt per plan): each trial clears its scene, the planner
+        choosing what to pick (:func:`~contourgrasp.sim.clearing.run_clearing`).
 
     Raises
     ------
@@ -91,9 +99,16 @@ class Bench:
     hand_model: object = None
     scene_kind: str = "single"
     attempts: int = 1
+    protocol: str = "trials"
 
     def __post_init__(self):
         choice("scene", self.scene_kind, SCENE_KINDS, error=SimulationError)
+        choice("protocol", self.protocol, PROTOCOLS, error=SimulationError)
+        if self.protocol == "clear" and self.scene_kind == "single":
+            raise SimulationError("protocol 'clear' needs a scene of several objects: scene 'clutter' or 'bin'")
+        if self.protocol == "clear" and self.attempts != 1:
+            raise SimulationError(f"attempts must be 1 with protocol 'clear' (it makes its own: up to "
+                                  f"{ATTEMPTS_PER_OBJECT} per object), got {self.attempts!r}")
         choice("sensor", self.sensor, tuple(SENSORS), error=SimulationError)
         if not isinstance(self.robot, bool):
             raise SimulationError(f"robot must be True or False, got {self.robot!r}")
@@ -160,11 +175,13 @@ class Bench:
         """Run one trial; ``plan`` replaces the named planner's callable (same answers), ``observe`` see run_trial."""
         seed = self.seed + trial
         pool = self.pool(obj.name) if self.scene_kind != "single" else ()
-        return run_trial(obj, seed=seed, planner=plan or make_planner(planner, self.hand, seed=seed),
-                         hand=self.hand if self.hand_model is None else self.hand_model,
-                         sensor=self.sensor, tilt=self.tilt, camera=self.camera, workspace=self.workspace,
-                         observe=observe, scene_kind=self.scene_kind, pool=pool, robot=self.robot,
-                         attempts=self.attempts)
+        common = {"seed": seed, "planner": plan or make_planner(planner, self.hand, seed=seed),
+                  "hand": self.hand if self.hand_model is None else self.hand_model, "sensor": self.sensor,
+                  "tilt": self.tilt, "camera": self.camera, "workspace": self.workspace, "observe": observe,
+                  "scene_kind": self.scene_kind, "pool": pool, "robot": self.robot}
+        if self.protocol == "clear":
+            return run_clearing(obj, **common)
+        return run_trial(obj, **common, attempts=self.attempts)
 
 
 @dataclass(frozen=True)

@@ -60,6 +60,9 @@ class _TrialLine(BaseModel):
     pose: _Pose | None
     outcomes: list[bool] = []
     detected: list[bool] = []
+    scene_objects: int | None = None
+    cleared: int | None = None
+    ended: str | None = None
 
 
 def settings(bench: Bench) -> dict:
@@ -67,8 +70,9 @@ def settings(bench: Bench) -> dict:
 
     Object and hand geometry, planner options and scene parameters enter as
     short digests beside the names a reader recognises. The scene's kind is
-    named only when it is not ``single``, and the attempts only when more than
-    one, so journals written before there were kinds or attempts resume.
+    named only when it is not ``single``, the attempts only when more than
+    one and the protocol only when not ``trials``, so journals written before there were kinds, attempts
+    or protocols resume.
     """
     kind = {} if bench.scene_kind == "single" else {"scene": bench.scene_kind}
     return kind | {
@@ -83,6 +87,7 @@ def settings(bench: Bench) -> dict:
         **({} if bench.tilt is None else {"tilt": bench.tilt}),
         **({"robot in view": True} if bench.robot else {}),
         **({"attempts": bench.attempts} if bench.attempts > 1 else {}),
+        **({"protocol": bench.protocol} if bench.protocol != "trials" else {}),
         "camera": digest(bench.camera),
         "workspace": digest(bench.workspace),
         **({} if bench.hand_model is None else

@@ -29,6 +29,7 @@ from pathlib import Path
 
 from ...io.plan_file import atomic_outputs, write_json
 from ..planners import BASELINES, ablation_planners, synthesis_planner
+from ..clearing import ENDINGS
 from ..procedural import FAMILIES, procedural_family
 from ..trial import TrialRecord
 from .config import SHORT_CAUSES, Bench, BenchTrial, label
@@ -144,7 +145,7 @@ def markdown(bench: Bench, results, *, wall_time: float, kept: int = 0) -> str:
     for planner in bench.planners:
         lines += ["", f"## {planner}", "", *trial_table(bench, results, planner), "",
                   f"Causes of failure ({planner}):", "", *cause_table(bench, results, planner)]
-    lines += attempts_section(bench, results)
+    lines += attempts_section(bench, results) + clearing_section(bench, results)
     lines += ["", "✓ success; ✗ failure and its cause: " + _cause_legend(bench) + ". " + _success_text(bench)]
     return "\n".join(lines) + "\n"
 
@@ -161,6 +162,9 @@ def _cause_legend(bench: Bench) -> str:
 
 
 def _success_text(bench: Bench) -> str:
+    if bench.protocol == "clear":
+        return ("Success: every object of the scene cleared (taken off the table by a grasp a new picture told "
+                "lifted); the cause is the last attempt's.")
     text = "Success: lifted at least 0.10 m and moved less than 0.02 m in the hand during the 2 s hold."
     if bench.scene_kind == "single":
         return text
@@ -187,9 +191,14 @@ def _scene_text(bench: Bench) -> str:
         return ""
     what = ("2-4 objects on the table" if bench.scene_kind == "clutter" else
             "1-3 objects in a bin (walls 10 cm, floor 40 x 30 cm)")
+    tilt = '0-25 deg' if bench.tilt is None else f'{math.degrees(bench.tilt):.0f} deg'
+    if bench.protocol == "clear":
+        return (f" Scene `{bench.scene_kind}`: {what}, each object in turn the first placed among neighbours drawn "
+                f"from the other objects of its split, touching or up to 4 cm apart; the camera tilted {tilt}. "
+                "Protocol `clear`: pick until the table is empty, nothing can be planned or two attempts in a row "
+                "fail, the planner choosing what to pick (docs/bench.md, 'Clearing a table').")
     return (f" Scene `{bench.scene_kind}`: {what}, each object in turn the target among neighbours drawn from the "
-            "other objects of its split, touching or up to 4 cm apart; the camera tilted "
-            f"{'0-25 deg' if bench.tilt is None else f'{math.degrees(bench.tilt):.0f} deg'}; the planner is "
+            f"other objects of its split, touching or up to 4 cm apart; the camera tilted {tilt}; the planner is "
             "given the pixel deepest inside the target's exact mask, as a user's click.")
 
 
@@ -303,7 +312,7 @@ def split_markdown(bench: Bench, results, *, wall_time: float, kept: int = 0) ->
         "",
         *object_table(bench, results),
     ]
-    lines += attempts_section(bench, results)
+    lines += attempts_section(bench, results) + clearing_section(bench, results)
     families = family_table(bench, results)
     if families:
         lines += ["", "## Per family (procedural objects)", "",
@@ -414,14 +423,45 @@ def attempts_section(bench: Bench, results) -> list[str]:
             made = [max(len(r.outcomes), 1) for r in own]
             lines.append(_row([planner, group, _counted_cell(first), _counted_cell([r.success for r in own]),
                                f"{statistics.fmean(made):.2f}" if made else "-"]))
+    return lines + detection_table(results)
+
+
+def detection_table(results) -> list[str]:
+    """Every attempt made, its outcome as the picture after it told it (detected) against the simulator's (true)."""
     pairs = [(d, t) for r in results for d, t in zip(r.record.detected, r.record.outcomes)]
     told = {(d, t): sum(1 for p in pairs if p == (d, t)) for d in (True, False) for t in (True, False)}
-    lines += ["", *_header("detected \\ true", ["succeeded", "failed"]),
-              _row(["succeeded", told[True, True], told[True, False]]),
-              _row(["failed", told[False, True], told[False, False]]),
-              "", f"False success: {told[True, False]} of {len(pairs)} attempts "
-              f"({100 * told[True, False] / max(len(pairs), 1):.1f} %)."]
-    return lines
+    return ["", *_header("detected \\ true", ["succeeded", "failed"]),
+            _row(["succeeded", told[True, True], told[True, False]]),
+            _row(["failed", told[False, True], told[False, False]]),
+            "", f"False success: {told[True, False]} of {len(pairs)} attempts "
+            f"({100 * told[True, False] / max(len(pairs), 1):.1f} %)."]
+
+
+def clearing_section(bench: Bench, results) -> list[str]:
+    """With the ``clear`` protocol: per planner and group, success per attempt, objects cleared, attempts per
+    object and tables cleared; how the runs ended; how the pictures told each attempt. [] otherwise."""
+    if bench.protocol != "clear":
+        return []
+    lines = ["", "## Clearing the table", "",
+             "Per planner and group: every attempt's true outcome (an object taken off the table), the objects "
+             "cleared of all objects in the scenes, attempts made per object, and the scenes cleared entirely; "
+             "each with its 95 % Wilson interval.", ""]
+    lines += _header("planner", ["group", "success per attempt", "objects cleared", "attempts per object",
+                                 "tables cleared"], left=1)
+    groups = _groups(bench) if bench.splits else [("all", tuple(o.name for o in bench.objects))]
+    for planner in bench.planners:
+        for group, members in groups:
+            own = _of(results, planner, members)
+            objects, cleared = sum(r.scene_objects or 0 for r in own), sum(r.cleared or 0 for r in own)
+            made = sum(len(r.outcomes) for r in own)
+            lines.append(_row([planner, group, _counted_cell([o for r in own for o in r.outcomes]),
+                               _counted_cell([True] * cleared + [False] * (objects - cleared)),
+                               f"{made / objects:.2f}" if objects else "-", _counted_cell([r.success for r in own])]))
+    lines += ["", *_header("planner", list(ENDINGS))]
+    for planner in bench.planners:
+        own = records(results, planner)
+        lines.append(_row([planner, *(sum(r.ended == ending for r in own) for ending in ENDINGS)]))
+    return lines + detection_table(results)
 
 
 def _counted_cell(successes) -> str:

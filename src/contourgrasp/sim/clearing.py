@@ -1,0 +1,178 @@
+"""Clearing a table: the clutter-removal protocol grasping papers report (VGN's ``clutter_removal.py``).
+
+:func:`run_clearing` takes a ``clutter`` or ``bin`` scene (:mod:`contourgrasp.sim.clutter`) and picks
+until the table is empty, nothing can be planned, or :data:`FAILURES_IN_A_ROW` attempts in a row
+failed, at most :data:`ATTEMPTS_PER_OBJECT` attempts per object in the scene. Each attempt:
+
+1. a new picture (the seeded sensor noise of :func:`~contourgrasp.sim.trial.run_trial`'s attempts);
+2. the planner chooses the object itself, as a user's camera frame with no click does (the
+   perception's ``"hand"`` rule); when it has no plan for that one, it is asked about every other object
+   standing wholly in view (:func:`~contourgrasp.pipeline.find_objects`, at most :data:`MAX_CANDIDATES`),
+   each at the pixel deepest inside it, until one has a plan. Nothing planned ends the run;
+3. the grasp is executed on the object the plan is on (the one most of the plan's pixels see), the
+   others its neighbours; the closed hand carries what it holds out of view;
+4. the closed hand's joint readings tell whether it holds something
+   (:func:`~contourgrasp.sim.detect.fingers_hold`: a finger stopped short of where it closes on nothing),
+   as a robot's encoders tell it. Told it holds: whatever it holds is put away
+   (:meth:`~contourgrasp.sim.scene.Scene.remove`), and the memory of failed grasps starts afresh (the
+   next object is another one). Told empty: the hand leaves, and the next plan remembers the grasp
+   that failed (:class:`~contourgrasp.synthesis.GraspMemory`);
+5. an object knocked off the table (or out of the bin) is lost: removed, not cleared.
+
+What counts, as in VGN: an attempt succeeds when the hand has taken an object off the table -- after
+the lift, the hold and the carry away, an object is in the hand (above the table's top, no longer over
+it). Touching a neighbour while closing is not a failure here (a trial's ``hit`` is); a descent stopped
+by a touch is, as always. An object is cleared when the joints told the attempt that held it a success
+and it was put away; one the hand held but the joints missed falls where the hand opened, off the table,
+and is lost. The run succeeds when every object was cleared.
+
+Why the joints and not a new picture, as :func:`~contourgrasp.sim.trial.run_trial`'s attempts: among
+several objects, a lifted one uncovers what stood behind it (a neighbour, a bin wall), and the picture
+then shows something standing where it stood: a success told a failure (docs/regrasp.md, "Clearing a
+table", has the counts). Whatever the hand holds after the carry away is off the table, which is all
+clearing asks.
+"""
+
+from __future__ import annotations
+
+import time
+import warnings
+
+import numpy as np
+
+from .. import pipeline
+from ..errors import ContourGraspWarning, InputError, NoFeasibleGrasp, SimulationError
+from ..hand import Hand
+from ..synthesis import GraspMemory
+from ..validation import choice
+from .clutter import deepest_pixel
+from .detect import fingers_hold
+from .render import DEFAULT_SENSOR, Sensor, render, tilted_view, truth_labels
+from .scene import Camera, Workspace
+from .tendon_hand import HandDesign
+from .trial import (NO_PLAN_FIELDS, PARKED, SETTLE_AFTER_FAILURE, Execution, TrialRecord, carry_away, noise_seed,
+                    execute_planned, trial_scene, with_wrist)
+
+#: A run stops after this many attempts in a row told failed (VGN's ``consecutive_failures``).
+FAILURES_IN_A_ROW = 2
+#: At most this many attempts per object in the scene.
+ATTEMPTS_PER_OBJECT = 3
+#: At most this many objects are asked about when the planner's own choice has no plan.
+MAX_CANDIDATES = 6
+#: How a clearing run ended (:attr:`TrialRecord.ended`).
+CLEARED, NOTHING_PLANNED, FAILED_IN_A_ROW, ATTEMPT_LIMIT = ("table cleared", "nothing to plan on",
+                                                            "failed twice in a row", "attempt limit")
+ENDINGS = (CLEARED, NOTHING_PLANNED, FAILED_IN_A_ROW, ATTEMPT_LIMIT)
+
+
+def run_clearing(object_spec, *, seed: int, planner, pool, scene_kind: str = "clutter",
+                 hand: Hand | str = "five-finger-linear", sensor: Sensor | str = DEFAULT_SENSOR,
+                 tilt: float | None = None, timing: str = "thesis", design: HandDesign = HandDesign(),
+                 camera: Camera = Camera(), workspace: Workspace = Workspace(), execution: Execution = Execution(),
+                 observe=None, robot: bool = False) -> TrialRecord:
+    """Clear a ``clutter`` or ``bin`` scene (module docstring); the record of the whole run.
+
+    The scene and every parameter are :func:`~contourgrasp.sim.trial.run_trial`'s (``object_spec`` is the
+    scene's first object); ``planner`` must have the ``plan`` method of :mod:`contourgrasp.sim.planners`.
+    The record's ``outcomes`` and ``detected`` are every attempt's true and told outcome,
+    ``scene_objects`` and ``cleared`` count the objects, ``ended`` is one of :data:`ENDINGS`, and
+    ``success`` says whether every object was cleared; its other fields are the last attempt's,
+    ``plan_time`` the attempts' sum.
+    """
+    started = time.perf_counter()
+    choice("scene", scene_kind, ("clutter", "bin"), error=SimulationError)
+    if not hasattr(planner, "plan"):
+        raise SimulationError("clearing a table needs a planner with a plan method that takes memory= "
+                              "(contourgrasp.sim.planners)")
+    hand, design = with_wrist(planner, hand, design)
+    scene = trial_scene(object_spec, seed=seed, scene_kind=scene_kind, pool=pool, hand=hand, design=design,
+                        timing=timing, camera=camera, workspace=workspace, robot=robot)
+    if tilt is not None:
+        scene.view = tilted_view(tilt, camera.height)
+    memory, outcomes, detected, cleared, in_a_row, plan_time = GraspMemory(), [], [], 0, 0, 0.0
+    fields, plan_error, ended = dict(NO_PLAN_FIELDS), None, ATTEMPT_LIMIT
+    for attempt in range(ATTEMPTS_PER_OBJECT * len(scene.objects)):
+        _remove_lost(scene)
+        if not scene.present:
+            ended = CLEARED
+            break
+        rgb, depth = render(scene, sensor=sensor, seed=seed if attempt == 0 else noise_seed(seed, attempt, 0))
+        planned, plan_error, spent = _plan_any(planner, rgb, depth, scene.camera.intrinsics, memory)
+        plan_time += spent
+        if planned is None:
+            fields, ended = dict(NO_PLAN_FIELDS), NOTHING_PLANNED
+            break
+        scene.retarget(planned_object(scene, planned))
+        fields = execute_planned(scene, planned.T_camera_hand, planned.approach_depth, planned.grasp_height, execution)
+        carry_away(scene)
+        held = _held(scene)
+        outcomes.append(bool(held))
+        detected.append(fingers_hold(scene.finger_readings(), scene.free_closure()))
+        if detected[-1]:
+            for index in held:
+                scene.remove(index)
+            cleared, memory, in_a_row = cleared + len(held), GraspMemory(), 0
+        else:
+            memory = memory.with_failure(planned.metric.contour_xy, planned.pose, approach=planned.approach)
+            in_a_row += 1
+        scene.set_hand(*PARKED, 0.0)  # the hand opens and leaves; what it still holds falls where it is
+        scene.step(SETTLE_AFTER_FAILURE)
+        if in_a_row == FAILURES_IN_A_ROW:
+            ended = FAILED_IN_A_ROW
+            break
+    else:
+        _remove_lost(scene)
+        ended = CLEARED if not scene.present else ATTEMPT_LIMIT
+    if observe is not None:
+        observe(scene)
+    fields["success"] = cleared == len(scene.objects)
+    return TrialRecord(object=scene.objects[0].name, seed=seed, **fields, plan_error=plan_error, sim_time=scene.time,
+                       plan_time=plan_time, wall_time=time.perf_counter() - started, outcomes=tuple(outcomes),
+                       detected=tuple(detected), scene_objects=len(scene.objects), cleared=cleared, ended=ended)
+
+
+def _plan_any(planner, rgb, depth, intrinsics, memory):
+    """(PlannedGrasp or None, the last planning error or None, seconds): the planner's own choice of object,
+    else the first other object standing wholly in view that has a plan."""
+    started, error = time.perf_counter(), None
+    with warnings.catch_warnings():  # a run's record is its outcome: its perception's notes are not printed
+        warnings.simplefilter("ignore", ContourGraspWarning)
+        try:
+            return planner.plan(rgb, depth, intrinsics, memory=memory), None, time.perf_counter() - started
+        except (NoFeasibleGrasp, InputError) as err:
+            error = str(err)
+        try:
+            candidates = pipeline.find_objects(depth, intrinsics, rgb=rgb).candidates
+        except InputError as err:
+            return None, str(err), time.perf_counter() - started
+        for candidate in [c for c in candidates if c.in_view][:MAX_CANDIDATES]:
+            try:
+                planned = planner.plan(rgb, depth, intrinsics, memory=memory, target_px=deepest_pixel(candidate.mask))
+                return planned, None, time.perf_counter() - started
+            except (NoFeasibleGrasp, InputError) as err:
+                error = str(err)
+    return None, error, time.perf_counter() - started
+
+
+def planned_object(scene, planned) -> int:
+    """The object (index into the scene's objects) a plan is on: the one most of the pixels that saw its target
+    see (:func:`~contourgrasp.sim.render.truth_labels`); the first present when none does."""
+    pixels = planned.seen if planned.seen is not None else planned.segmentation.mask
+    labels = truth_labels(scene)[np.asarray(pixels, dtype=bool)] - 1
+    counts = np.bincount(labels[(labels >= 0) & (labels < len(scene.objects))], minlength=len(scene.objects))
+    counts[[k for k in range(len(scene.objects)) if k not in scene.present]] = 0
+    return int(np.argmax(counts)) if counts.any() else scene.present[0]
+
+
+def _held(scene) -> list[int]:
+    """The objects present that the hand holds after carrying them away: above the table's top and no longer
+    over it (or its bin)."""
+    coms = scene.coms()
+    return [k for k, on, com in zip(scene.present, scene.on_support(), coms, strict=True) if not on and com[2] > 0.0]
+
+
+def _remove_lost(scene) -> None:
+    """Remove the objects knocked off the table (or out of the bin): lost, not cleared."""
+    for k, on in zip(scene.present, scene.on_support(), strict=True):
+        if not on:
+            scene.remove(k)

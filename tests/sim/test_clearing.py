@@ -1,0 +1,119 @@
+"""Clearing a table (sim.clearing): what ends a run, what counts, objects taken out of a scene, the joints' tell."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from contourgrasp import load_hand
+from contourgrasp.errors import NoFeasibleGrasp, SimulationError
+from contourgrasp.sim import build_clutter, build_scene, execute_grasp, run_clearing, scripted_grasp, truth_labels
+from contourgrasp.sim.clearing import CLEARED, FAILED_IN_A_ROW, FAILURES_IN_A_ROW, MAX_CANDIDATES, NOTHING_PLANNED
+from contourgrasp.sim.detect import fingers_hold
+from contourgrasp.sim.planners import make_planner
+from contourgrasp.sim.scene import FREE_CLOSURE_TIME, PARK_HEIGHT
+from contourgrasp.tolerances import HOLD_READING
+
+POOL = ("can-standing", "case")
+HAND = load_hand("five-finger-linear")
+
+
+def test_a_clutter_of_cans_and_a_case_is_cleared_every_attempt_told_right():
+    record = run_clearing("can", seed=1, planner=make_planner("default", HAND), pool=POOL)
+    assert record.ended == CLEARED and record.success and record.cause is None
+    assert record.cleared == record.scene_objects == 4
+    assert record.outcomes == record.detected == (True,) * 4
+
+
+def test_same_seed_same_run_in_a_bin():
+    first, again = (run_clearing("can", seed=2, planner=make_planner("default", HAND), pool=POOL, scene_kind="bin")
+                    for _ in range(2))
+    assert first == again and first.ended == CLEARED and first.cleared == first.scene_objects == 1
+
+
+class _Aside:
+    """The ``default`` planner with every plan moved 30 cm aside, over bare table: it closes on air."""
+
+    def __init__(self):
+        self.planner, self.memories = make_planner("default", HAND), []
+
+    def plan(self, rgb, depth, intrinsics, *, memory=None, **target):
+        self.memories.append(memory)
+        planned = self.planner.plan(rgb, depth, intrinsics, memory=memory, **target)
+        aside = planned.T_camera_hand.copy()
+        aside[1, 3] += 0.3
+        return replace(planned, T_camera_hand=aside)
+
+
+def test_two_grasps_on_air_told_by_the_joints_end_the_run_the_second_remembering_the_first():
+    planner = _Aside()
+    record = run_clearing("can", seed=1, planner=planner, pool=POOL)
+    assert record.ended == FAILED_IN_A_ROW and not record.success and record.cleared == 0
+    assert record.outcomes == record.detected == (False,) * FAILURES_IN_A_ROW
+    assert [len(m) for m in planner.memories] == [0, 1]
+
+
+class _NoPlan:
+    """Never has a plan; keeps the target pixel of every call."""
+
+    def __init__(self):
+        self.asked = []
+
+    def plan(self, rgb, depth, intrinsics, *, memory=None, target_px=None):
+        self.asked.append((target_px, depth))
+        raise NoFeasibleGrasp("no plan here")
+
+
+def test_with_no_plan_every_object_in_view_is_asked_about_then_the_run_ends():
+    planner = _NoPlan()
+    record = run_clearing("can", seed=1, planner=planner, pool=POOL)
+    assert record.ended == NOTHING_PLANNED and record.outcomes == () and record.cleared == 0
+    assert record.plan_error == "no plan here" and record.pose is None
+    first, *others = [pixel for pixel, _ in planner.asked]
+    assert first is None and 2 <= len(others) <= MAX_CANDIDATES and len(set(others)) == len(others)
+    scene = build_clutter("can", POOL, kind="clutter", seed=1)
+    labels = truth_labels(scene)
+    assert all(labels[v, u] > 0 for u, v in others)  # each pixel on an object
+
+
+def test_an_object_taken_out_leaves_the_scene_stays_out_and_is_never_a_neighbour():
+    scene = build_clutter("can", POOL, kind="clutter", seed=1, settle=0.2)
+    assert len(scene.objects) == 4 and scene.present == (0, 1, 2, 3) and scene.on_support().all()
+    scene.remove(1)
+    assert scene.present == (0, 2, 3) and len(scene.neighbour_coms()) == 2 and scene.on_support().all()
+    assert not (truth_labels(scene) == 2).any()
+    parked = scene.data.xipos[scene.model.body("neighbour_0").id].copy()
+    scene.step(1.0)
+    assert np.linalg.norm(scene.data.xipos[scene.model.body("neighbour_0").id] - parked) < 1e-3
+    with pytest.raises(SimulationError, match="not in the scene"):
+        scene.retarget(1)
+    scene.retarget(2)
+    assert scene.object is scene.objects[2] and scene.object.name == "case"
+    assert (truth_labels(scene) == 3).any() and len(scene.neighbour_coms()) == 2
+
+
+def test_fingers_hold_when_one_joint_stops_short_of_its_free_closure():
+    free = np.array([0.5, 1.0, 1.2])
+    assert not fingers_hold(free + 0.5 * HOLD_READING, free)
+    assert fingers_hold(free - [0.0, HOLD_READING, 0.0], free)
+    assert fingers_hold([], [])  # no joints to read: never told empty
+
+
+def test_a_hand_closed_on_air_reads_its_free_closure_and_one_holding_a_can_does_not():
+    scene = build_scene("can", seed=0)
+    transform, depth = scripted_grasp(scene, "good")
+    assert execute_grasp(scene, transform, depth).success
+    assert fingers_hold(scene.finger_readings(), scene.free_closure())
+    empty = build_scene("can", seed=0)
+    empty.set_hand(0.0, 0.0, PARK_HEIGHT, 0.0, closing=1.0)
+    empty.step(FREE_CLOSURE_TIME)
+    assert len(empty.free_closure()) == 2 * len(HAND.fingers)  # two flexion joints per finger
+    assert np.max(np.abs(empty.finger_readings() - empty.free_closure())) < 0.1 * HOLD_READING
+    assert not fingers_hold(empty.finger_readings(), empty.free_closure())
+
+
+def test_clearing_needs_several_objects_and_a_planner_that_remembers():
+    with pytest.raises(SimulationError, match="scene"):
+        run_clearing("can", seed=0, planner=make_planner("default", HAND), pool=POOL, scene_kind="single")
+    with pytest.raises(SimulationError, match="plan method"):
+        run_clearing("can", seed=0, planner=lambda rgb, depth, intrinsics: None, pool=POOL)
