@@ -7,7 +7,7 @@ import pytest
 
 from contourgrasp import load_hand
 from contourgrasp.errors import NoFeasibleGrasp, SimulationError
-from contourgrasp.sim import build_clutter, build_scene, execute_grasp, run_clearing, scripted_grasp, truth_labels
+from contourgrasp.sim import MISSED, NO_PLAN, build_clutter, build_scene, execute_grasp, run_clearing, scripted_grasp, truth_labels
 from contourgrasp.sim.clearing import CLEARED, FAILED_IN_A_ROW, FAILURES_IN_A_ROW, MAX_CANDIDATES, NOTHING_PLANNED
 from contourgrasp.sim.detect import fingers_hold
 from contourgrasp.sim.planners import make_planner
@@ -49,7 +49,7 @@ def test_two_grasps_on_air_told_by_the_joints_end_the_run_the_second_remembering
     planner = _Aside()
     record = run_clearing("can", seed=1, planner=planner, pool=POOL)
     assert record.ended == FAILED_IN_A_ROW and not record.success and record.cleared == 0
-    assert record.outcomes == record.detected == (False,) * FAILURES_IN_A_ROW
+    assert record.outcomes == record.detected == (False,) * FAILURES_IN_A_ROW and record.cause == MISSED
     assert [len(m) for m in planner.memories] == [0, 1]
 
 
@@ -68,7 +68,7 @@ def test_with_no_plan_every_object_in_view_is_asked_about_then_the_run_ends():
     planner = _NoPlan()
     record = run_clearing("can", seed=1, planner=planner, pool=POOL)
     assert record.ended == NOTHING_PLANNED and record.outcomes == () and record.cleared == 0
-    assert record.plan_error == "no plan here" and record.pose is None
+    assert record.plan_error == "no plan here" and record.pose is None and record.cause == NO_PLAN
     first, *others = [pixel for pixel, _ in planner.asked]
     assert first is None and 2 <= len(others) <= MAX_CANDIDATES and len(set(others)) == len(others)
     scene = build_clutter("can", POOL, kind="clutter", seed=1)

@@ -24,7 +24,9 @@ the lift, the hold and the carry away, an object is in the hand (above the table
 it). Touching a neighbour while closing is not a failure here (a trial's ``hit`` is); a descent stopped
 by a touch is, as always. An object is cleared when the joints told the attempt that held it a success
 and it was put away; one the hand held but the joints missed falls where the hand opened, off the table,
-and is lost. The run succeeds when every object was cleared.
+and is lost. The run succeeds when every object was cleared; when it does not, its cause is the last
+failed attempt's, "no feasible plan" when nothing could be planned, and otherwise (every attempt held
+something, yet an object was lost off the table) the hit of a neighbour.
 
 Why the joints and not a new picture, as :func:`~contourgrasp.sim.trial.run_trial`'s attempts: among
 several objects, a lifted one uncovers what stood behind it (a neighbour, a bin wall), and the picture
@@ -50,7 +52,7 @@ from .detect import fingers_hold
 from .render import DEFAULT_SENSOR, Sensor, render, tilted_view, truth_labels
 from .scene import Camera, Workspace
 from .tendon_hand import HandDesign
-from .trial import (NO_PLAN_FIELDS, PARKED, SETTLE_AFTER_FAILURE, Execution, TrialRecord, carry_away, noise_seed,
+from .trial import (HIT, NO_PLAN, NO_PLAN_FIELDS, PARKED, SETTLE_AFTER_FAILURE, Execution, TrialRecord, carry_away, noise_seed,
                     execute_planned, trial_scene, with_wrist)
 
 #: A run stops after this many attempts in a row told failed (VGN's ``consecutive_failures``).
@@ -90,7 +92,7 @@ def run_clearing(object_spec, *, seed: int, planner, pool, scene_kind: str = "cl
     if tilt is not None:
         scene.view = tilted_view(tilt, camera.height)
     memory, outcomes, detected, cleared, in_a_row, plan_time = GraspMemory(), [], [], 0, 0, 0.0
-    fields, plan_error, ended = dict(NO_PLAN_FIELDS), None, ATTEMPT_LIMIT
+    fields, plan_error, ended, failure = dict(NO_PLAN_FIELDS), None, ATTEMPT_LIMIT, HIT
     for attempt in range(ATTEMPTS_PER_OBJECT * len(scene.objects)):
         _remove_lost(scene)
         if not scene.present:
@@ -100,23 +102,17 @@ def run_clearing(object_spec, *, seed: int, planner, pool, scene_kind: str = "cl
         planned, plan_error, spent = _plan_any(planner, rgb, depth, scene.camera.intrinsics, memory)
         plan_time += spent
         if planned is None:
-            fields, ended = dict(NO_PLAN_FIELDS), NOTHING_PLANNED
+            fields, ended, failure = dict(NO_PLAN_FIELDS), NOTHING_PLANNED, NO_PLAN
             break
-        scene.retarget(planned_object(scene, planned))
-        fields = execute_planned(scene, planned.T_camera_hand, planned.approach_depth, planned.grasp_height, execution)
-        carry_away(scene)
-        held = _held(scene)
+        fields, held, told = _pick(scene, planned, execution)
         outcomes.append(bool(held))
-        detected.append(fingers_hold(scene.finger_readings(), scene.free_closure()))
-        if detected[-1]:
-            for index in held:
-                scene.remove(index)
+        detected.append(told)
+        failure = failure if held else fields["cause"]
+        if told:
             cleared, memory, in_a_row = cleared + len(held), GraspMemory(), 0
         else:
             memory = memory.with_failure(planned.metric.contour_xy, planned.pose, approach=planned.approach)
             in_a_row += 1
-        scene.set_hand(*PARKED, 0.0)  # the hand opens and leaves; what it still holds falls where it is
-        scene.step(SETTLE_AFTER_FAILURE)
         if in_a_row == FAILURES_IN_A_ROW:
             ended = FAILED_IN_A_ROW
             break
@@ -125,10 +121,27 @@ def run_clearing(object_spec, *, seed: int, planner, pool, scene_kind: str = "cl
         ended = CLEARED if not scene.present else ATTEMPT_LIMIT
     if observe is not None:
         observe(scene)
-    fields["success"] = cleared == len(scene.objects)
+    success = cleared == len(scene.objects)
+    fields |= {"success": success, "cause": None if success else failure}
     return TrialRecord(object=scene.objects[0].name, seed=seed, **fields, plan_error=plan_error, sim_time=scene.time,
                        plan_time=plan_time, wall_time=time.perf_counter() - started, outcomes=tuple(outcomes),
                        detected=tuple(detected), scene_objects=len(scene.objects), cleared=cleared, ended=ended)
+
+
+def _pick(scene, planned, execution) -> tuple[dict, list[int], bool]:
+    """Execute a plan on the object it is on, carry away what the hand holds, tell it from the joints, put it away
+    when told held, and park the hand (what it still holds falls where it is): (the record's fields of the
+    execution, the objects truly held, whether the joints told something held)."""
+    scene.retarget(planned_object(scene, planned))
+    fields = execute_planned(scene, planned.T_camera_hand, planned.approach_depth, planned.grasp_height, execution)
+    carry_away(scene)
+    held = _held(scene)
+    told = fingers_hold(scene.finger_readings(), scene.free_closure())
+    for index in held if told else ():
+        scene.remove(index)
+    scene.set_hand(*PARKED, 0.0)
+    scene.step(SETTLE_AFTER_FAILURE)
+    return fields, held, told
 
 
 def _plan_any(planner, rgb, depth, intrinsics, memory):
