@@ -7,7 +7,7 @@ import pytest
 
 from contourgrasp import load_hand
 from contourgrasp.errors import NoFeasibleGrasp, SimulationError
-from contourgrasp.sim import MISSED, NO_PLAN, build_clutter, build_scene, execute_grasp, run_clearing, scripted_grasp, truth_labels
+from contourgrasp.sim import HIT, MISSED, NO_PLAN, build_clutter, build_scene, execute_grasp, run_clearing, scripted_grasp, truth_labels
 from contourgrasp.sim.clearing import CLEARED, FAILED_IN_A_ROW, FAILURES_IN_A_ROW, MAX_CANDIDATES, NOTHING_PLANNED
 from contourgrasp.sim.detect import fingers_hold
 from contourgrasp.sim.planners import make_planner
@@ -38,19 +38,37 @@ class _Aside:
         self.planner, self.memories = make_planner("default", HAND), []
 
     def plan(self, rgb, depth, intrinsics, *, memory=None, **target):
-        self.memories.append(memory)
         planned = self.planner.plan(rgb, depth, intrinsics, memory=memory, **target)
+        self.memories.append((len(memory), target.get("target_px"), planned.seen))
         aside = planned.T_camera_hand.copy()
         aside[1, 3] += 0.3
         return replace(planned, T_camera_hand=aside)
 
 
-def test_two_grasps_on_air_told_by_the_joints_end_the_run_the_second_remembering_the_first():
+def test_two_grasps_on_air_told_by_the_joints_end_the_run_the_second_on_another_object():
     planner = _Aside()
     record = run_clearing("can", seed=1, planner=planner, pool=POOL)
     assert record.ended == FAILED_IN_A_ROW and not record.success and record.cleared == 0
-    assert record.outcomes == record.detected == (False,) * FAILURES_IN_A_ROW and record.cause == MISSED
-    assert [len(m) for m in planner.memories] == [0, 1]
+    assert record.outcomes == record.detected == (False,) * FAILURES_IN_A_ROW and record.cause in (MISSED, HIT)
+    (first_memory, first_pixel, first_seen), (second_memory, second_pixel, _) = planner.memories
+    assert first_memory == second_memory == 0 and first_pixel is None  # the planner's own choice, then ...
+    assert not first_seen[second_pixel[1], second_pixel[0]]  # ... an object no grasp failed on
+
+
+def test_a_failure_is_remembered_on_its_object_and_an_object_failed_on_is_planned_with_its_memory():
+    from contourgrasp.sim.clearing import _memory_of, _with_failure
+
+    planner = make_planner("default", HAND)
+    scene = build_clutter("can", POOL, kind="clutter", seed=1)
+    from contourgrasp.sim import render
+
+    rgb, depth = render(scene, seed=1)
+    planned = planner.plan(rgb, depth, scene.camera.intrinsics)
+    failed = _with_failure((), planned)
+    failed = _with_failure(failed, planned)  # the same object again: one record, two failures
+    assert len(failed) == 1 and len(failed[0].memory) == 2
+    assert len(_memory_of(planned.seen, failed)) == 2
+    assert len(_memory_of(np.roll(planned.seen, 200, axis=1), failed)) == 0  # 200 px aside: another object
 
 
 class _NoPlan:

@@ -6,17 +6,20 @@ failed, at most :data:`ATTEMPTS_PER_OBJECT` attempts per object in the scene. Ea
 
 1. a new picture (the seeded sensor noise of :func:`~contourgrasp.sim.trial.run_trial`'s attempts);
 2. the planner chooses the object itself, as a user's camera frame with no click does (the
-   perception's ``"hand"`` rule); when it has no plan for that one, it is asked about every other object
-   standing wholly in view (:func:`~contourgrasp.pipeline.find_objects`, at most :data:`MAX_CANDIDATES`),
-   each at the pixel deepest inside it, until one has a plan. Nothing planned ends the run;
+   perception's ``"hand"`` rule). After a grasp failed, and whenever the planner's own choice has no
+   plan, it is asked about every object standing wholly in view
+   (:func:`~contourgrasp.pipeline.find_objects`, at most :data:`MAX_CANDIDATES`, each at the pixel deepest
+   inside it), those no grasp failed on first, then those with the fewest failures, until one has a
+   plan; each object is planned with the memory of the grasps that failed on it (an object is the one a
+   failure was on when it stands within :data:`SAME_OBJECT_PX` of where that failure's object stood).
+   Nothing planned ends the run;
 3. the grasp is executed on the object the plan is on (the one most of the plan's pixels see), the
    others its neighbours; the closed hand carries what it holds out of view;
 4. the closed hand's joint readings tell whether it holds something
    (:func:`~contourgrasp.sim.detect.fingers_hold`: a finger stopped short of where it closes on nothing),
    as a robot's encoders tell it. Told it holds: whatever it holds is put away
-   (:meth:`~contourgrasp.sim.scene.Scene.remove`), and the memory of failed grasps starts afresh (the
-   next object is another one). Told empty: the hand leaves, and the next plan remembers the grasp
-   that failed (:class:`~contourgrasp.synthesis.GraspMemory`);
+   (:meth:`~contourgrasp.sim.scene.Scene.remove`). Told empty: the hand leaves, and the grasp that failed is
+   remembered on its object (:class:`~contourgrasp.synthesis.GraspMemory`);
 5. an object knocked off the table (or out of the bin) is lost: removed, not cleared.
 
 What counts, as in VGN: an attempt succeeds when the hand has taken an object off the table -- after
@@ -39,7 +42,9 @@ from __future__ import annotations
 
 import time
 import warnings
+from dataclasses import dataclass
 
+import cv2
 import numpy as np
 
 from .. import pipeline
@@ -61,6 +66,8 @@ FAILURES_IN_A_ROW = 2
 ATTEMPTS_PER_OBJECT = 3
 #: At most this many objects are asked about when the planner's own choice has no plan.
 MAX_CANDIDATES = 6
+#: A failed grasp's object is the object standing within this many pixels of where it stood (it may have been pushed).
+SAME_OBJECT_PX = 20
 #: How a clearing run ended (:attr:`TrialRecord.ended`).
 CLEARED, NOTHING_PLANNED, FAILED_IN_A_ROW, ATTEMPT_LIMIT = ("table cleared", "nothing to plan on",
                                                             "failed twice in a row", "attempt limit")
@@ -91,7 +98,7 @@ def run_clearing(object_spec, *, seed: int, planner, pool, scene_kind: str = "cl
                         timing=timing, camera=camera, workspace=workspace, robot=robot)
     if tilt is not None:
         scene.view = tilted_view(tilt, camera.height)
-    memory, outcomes, detected, cleared, in_a_row, plan_time = GraspMemory(), [], [], 0, 0, 0.0
+    failed, outcomes, detected, cleared, in_a_row, plan_time = (), [], [], 0, 0, 0.0
     fields, plan_error, ended, failure = dict(NO_PLAN_FIELDS), None, ATTEMPT_LIMIT, HIT
     for attempt in range(ATTEMPTS_PER_OBJECT * len(scene.objects)):
         _remove_lost(scene)
@@ -99,7 +106,7 @@ def run_clearing(object_spec, *, seed: int, planner, pool, scene_kind: str = "cl
             ended = CLEARED
             break
         rgb, depth = render(scene, sensor=sensor, seed=seed if attempt == 0 else noise_seed(seed, attempt, 0))
-        planned, plan_error, spent = _plan_any(planner, rgb, depth, scene.camera.intrinsics, memory)
+        planned, plan_error, spent = _plan_next(planner, rgb, depth, scene.camera.intrinsics, failed)
         plan_time += spent
         if planned is None:
             fields, ended, failure = dict(NO_PLAN_FIELDS), NOTHING_PLANNED, NO_PLAN
@@ -109,10 +116,9 @@ def run_clearing(object_spec, *, seed: int, planner, pool, scene_kind: str = "cl
         detected.append(told)
         failure = failure if held else fields["cause"]
         if told:
-            cleared, memory, in_a_row = cleared + len(held), GraspMemory(), 0
+            cleared, in_a_row = cleared + len(held), 0
         else:
-            memory = memory.with_failure(planned.metric.contour_xy, planned.pose, approach=planned.approach)
-            in_a_row += 1
+            failed, in_a_row = _with_failure(failed, planned), in_a_row + 1
         if in_a_row == FAILURES_IN_A_ROW:
             ended = FAILED_IN_A_ROW
             break
@@ -144,21 +150,43 @@ def _pick(scene, planned, execution) -> tuple[dict, list[int], bool]:
     return fields, held, told
 
 
-def _plan_any(planner, rgb, depth, intrinsics, memory):
-    """(PlannedGrasp or None, the last planning error or None, seconds): the planner's own choice of object,
-    else the first other object standing wholly in view that has a plan."""
+@dataclass(frozen=True)
+class _Failed:
+    """An object a grasp failed on: the pixel (u, v) deepest inside the pixels that saw it, and its memory."""
+
+    pixel: tuple[int, int]
+    memory: GraspMemory
+
+
+def _with_failure(failed: tuple[_Failed, ...], planned) -> tuple[_Failed, ...]:
+    """``failed`` with ``planned``'s grasp remembered: on the object it was planned on, added to that object's
+    memory when an earlier failure lies on it, else a new object's."""
+    mask = _planned_pixels(planned)
+    pixel = deepest_pixel(mask)
+    same = [f for f in failed if _on(mask, f.pixel)]
+    memory = (same[-1].memory if same else GraspMemory()).with_failure(planned.metric.contour_xy, planned.pose,
+                                                                       approach=planned.approach)
+    return (*(f for f in failed if f not in same), _Failed(pixel, memory))
+
+
+def _plan_next(planner, rgb, depth, intrinsics, failed: tuple[_Failed, ...]):
+    """(PlannedGrasp or None, the last planning error or None, seconds): before any failure the planner's own
+    choice of object; then, or when it has no plan, every object standing wholly in view, those no grasp
+    failed on first (fewest failures first, then largest), each with its own memory."""
     started, error = time.perf_counter(), None
     with warnings.catch_warnings():  # a run's record is its outcome: its perception's notes are not printed
         warnings.simplefilter("ignore", ContourGraspWarning)
-        try:
-            return planner.plan(rgb, depth, intrinsics, memory=memory), None, time.perf_counter() - started
-        except (NoFeasibleGrasp, InputError) as err:
-            error = str(err)
+        if not failed:
+            try:
+                return planner.plan(rgb, depth, intrinsics, memory=GraspMemory()), None, time.perf_counter() - started
+            except (NoFeasibleGrasp, InputError) as err:
+                error = str(err)
         try:
             candidates = pipeline.find_objects(depth, intrinsics, rgb=rgb).candidates
         except InputError as err:
             return None, str(err), time.perf_counter() - started
-        for candidate in [c for c in candidates if c.in_view][:MAX_CANDIDATES]:
+        memories = [_memory_of(c.mask, failed) for c in candidates if c.in_view][:MAX_CANDIDATES]
+        for candidate, memory in sorted(zip([c for c in candidates if c.in_view], memories), key=lambda c: len(c[1])):
             try:
                 planned = planner.plan(rgb, depth, intrinsics, memory=memory, target_px=deepest_pixel(candidate.mask))
                 return planned, None, time.perf_counter() - started
@@ -167,11 +195,28 @@ def _plan_any(planner, rgb, depth, intrinsics, memory):
     return None, error, time.perf_counter() - started
 
 
+def _memory_of(mask, failed: tuple[_Failed, ...]) -> GraspMemory:
+    """The memory of the last failure on the object whose pixels are ``mask``; empty when none lies on it."""
+    return next((f.memory for f in reversed(failed) if _on(mask, f.pixel)), GraspMemory())
+
+
+def _on(mask, pixel) -> bool:
+    """Whether ``pixel`` (u, v) lies within ``SAME_OBJECT_PX`` of ``mask``'s pixels: the same object, moved a little."""
+    near = cv2.dilate(np.asarray(mask, dtype=np.uint8), cv2.getStructuringElement(
+        cv2.MORPH_ELLIPSE, (2 * SAME_OBJECT_PX + 1,) * 2)) > 0
+    u, v = pixel
+    return bool(near[v, u])
+
+
+def _planned_pixels(planned) -> np.ndarray:
+    """(H, W) bool: the pixels that saw the object a plan is on."""
+    return np.asarray(planned.seen if planned.seen is not None else planned.segmentation.mask, dtype=bool)
+
+
 def planned_object(scene, planned) -> int:
     """The object (index into the scene's objects) a plan is on: the one most of the pixels that saw its target
     see (:func:`~contourgrasp.sim.render.truth_labels`); the first present when none does."""
-    pixels = planned.seen if planned.seen is not None else planned.segmentation.mask
-    labels = truth_labels(scene)[np.asarray(pixels, dtype=bool)] - 1
+    labels = truth_labels(scene)[_planned_pixels(planned)] - 1
     counts = np.bincount(labels[(labels >= 0) & (labels < len(scene.objects))], minlength=len(scene.objects))
     counts[[k for k in range(len(scene.objects)) if k not in scene.present]] = 0
     return int(np.argmax(counts)) if counts.any() else scene.present[0]
