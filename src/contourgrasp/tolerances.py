@@ -234,8 +234,11 @@ DETECT_CONTRAST = 30.0
 DETECT_RISE = 0.05
 #: A closed hand holds something when one of its finger joints reads at least this far (rad, or m for a slide) from
 #: where it stops closed on nothing: measured on clutter runs, an empty hand's joints lie within 0.0003 of it and a
-#: held object's stop at least 0.02 short (sim.detect.fingers_hold).
+#: squeezed object's stop at least 0.02 short (sim.detect.hand_holds) ...
 HOLD_READING = 0.01
+#: ... or when its wrist carries at least this much more than the empty hand, N (2 g; an object caged in the closed
+#: hand, every finger at its limit, still weighs: the bench's 12 g toy airplane 0.12 N, the empty hand 0.000).
+HOLD_LOAD = 0.02
 #: At most this many attempts per trial (bounds the work a bench can ask for).
 MAX_ATTEMPTS = 5
 

@@ -7,12 +7,15 @@ import pytest
 
 from contourgrasp import load_hand
 from contourgrasp.errors import NoFeasibleGrasp, SimulationError
-from contourgrasp.sim import HIT, MISSED, NO_PLAN, build_clutter, build_scene, execute_grasp, run_clearing, scripted_grasp, truth_labels
+from contourgrasp.sim import HIT, MISSED, NO_PLAN, HandReading, build_clutter, build_scene, execute_grasp, run_clearing, scripted_grasp, truth_labels
 from contourgrasp.sim.clearing import CLEARED, FAILED_IN_A_ROW, FAILURES_IN_A_ROW, MAX_CANDIDATES, NOTHING_PLANNED
-from contourgrasp.sim.detect import fingers_hold
+from contourgrasp.sim.detect import hand_holds
+from contourgrasp.sim.trial import carry_away
 from contourgrasp.sim.planners import make_planner
 from contourgrasp.sim.scene import FREE_CLOSURE_TIME, PARK_HEIGHT
-from contourgrasp.tolerances import HOLD_READING
+from contourgrasp.tolerances import HOLD_LOAD, HOLD_READING
+
+GRAVITY = 9.81
 
 POOL = ("can-standing", "case")
 HAND = load_hand("five-finger-linear")
@@ -110,24 +113,29 @@ def test_an_object_taken_out_leaves_the_scene_stays_out_and_is_never_a_neighbour
     assert (truth_labels(scene) == 3).any() and len(scene.neighbour_coms()) == 2
 
 
-def test_fingers_hold_when_one_joint_stops_short_of_its_free_closure():
-    free = np.array([0.5, 1.0, 1.2])
-    assert not fingers_hold(free + 0.5 * HOLD_READING, free)
-    assert fingers_hold(free - [0.0, HOLD_READING, 0.0], free)
-    assert fingers_hold([], [])  # no joints to read: never told empty
+def test_the_hand_holds_when_a_joint_stops_short_or_the_wrist_carries_a_load():
+    free = HandReading(np.array([0.5, 1.0, 1.2]), 0.0)
+    assert not hand_holds(HandReading(free.joints + 0.5 * HOLD_READING, 0.5 * HOLD_LOAD), free)
+    assert hand_holds(HandReading(free.joints - [0.0, HOLD_READING, 0.0], 0.0), free)
+    assert hand_holds(HandReading(free.joints, HOLD_LOAD), free)  # caged: every finger at its limit
+    assert not hand_holds(HandReading(np.array([]), 0.0), HandReading(np.array([]), 0.0))
 
 
-def test_a_hand_closed_on_air_reads_its_free_closure_and_one_holding_a_can_does_not():
+def test_a_hand_carrying_a_can_reads_its_weight_and_stopped_fingers_and_an_empty_one_its_free_closure():
     scene = build_scene("can", seed=0)
     transform, depth = scripted_grasp(scene, "good")
     assert execute_grasp(scene, transform, depth).success
-    assert fingers_hold(scene.finger_readings(), scene.free_closure())
+    carry_away(scene)
+    reading, free = scene.hand_reading(), scene.free_closure()
+    assert reading.load - free.load == pytest.approx(scene.object.mass * GRAVITY, rel=0.05)  # analytic: m g
+    assert np.max(np.abs(reading.joints - free.joints)) > HOLD_READING and hand_holds(reading, free)
     empty = build_scene("can", seed=0)
     empty.set_hand(0.0, 0.0, PARK_HEIGHT, 0.0, closing=1.0)
     empty.step(FREE_CLOSURE_TIME)
-    assert len(empty.free_closure()) == 2 * len(HAND.fingers)  # two flexion joints per finger
-    assert np.max(np.abs(empty.finger_readings() - empty.free_closure())) < 0.1 * HOLD_READING
-    assert not fingers_hold(empty.finger_readings(), empty.free_closure())
+    reading, free = empty.hand_reading(), empty.free_closure()
+    assert len(free.joints) == 2 * len(HAND.fingers)  # two flexion joints per finger
+    assert np.max(np.abs(reading.joints - free.joints)) < 0.1 * HOLD_READING and abs(free.load) < 0.1 * HOLD_LOAD
+    assert not hand_holds(reading, free)
 
 
 def test_clearing_needs_several_objects_and_a_planner_that_remembers():

@@ -10,7 +10,7 @@
 * :mod:`~contourgrasp.sim.render` -- RGB-D pictures by ray casting
 * :mod:`~contourgrasp.sim.trial` -- grasp execution and trials
 * :mod:`~contourgrasp.sim.clearing` -- clearing a table: the clutter-removal protocol (``bench --protocol clear``)
-* :mod:`~contourgrasp.sim.detect` -- telling a failed grasp from a new picture and the hand's joints (`told_lifted`)
+* :mod:`~contourgrasp.sim.detect` -- telling a failed grasp from the hand's readings and a new picture (`told_lifted`)
 * :mod:`~contourgrasp.sim.measure` -- fingertip paths against the preset
 * :mod:`~contourgrasp.sim.planners` -- the library's pipeline as trial planners, and two baselines
 * :mod:`~contourgrasp.sim.bench` -- Table 4.4 as a benchmark (``contourgrasp bench``), with its figures
@@ -36,7 +36,7 @@ from .procedural import procedural_object
 from .render import (BIN_LABEL, DEFAULT_SENSOR, SENSORS, Sensor, object_truth, render, render_view, sensor_named,
                      tilted_view, truth_labels)
 from ..perception import Intrinsics
-from .scene import ROBOT_ARM, SR300, Bin, Camera, Placement, Scene, Workspace, build_scene
+from .scene import ROBOT_ARM, SR300, Bin, Camera, HandReading, Placement, Scene, Workspace, build_scene
 from .clutter import SCENE_KINDS, Arrangement, arrange, build_clutter, target_pixel
 from .trial import (DROPPED, FAILURE_CAUSES, HIT, MISSED, NO_PLAN, PUSHED, SLIPPED, STRUCK, Execution, GraspOutcome,
                     TrialRecord, execute_grasp, hand_pose_from_matrix, pose_matrix, run_trial, scripted_grasp)
@@ -46,7 +46,7 @@ __all__ = [
     "procedural_object",
     "Arrangement", "BIN_LABEL", "Bin", "HIT", "SCENE_KINDS", "arrange", "build_clutter", "target_pixel", "truth_labels",
     "Camera", "ChainRule", "DEFAULT_SENSOR", "DROPPED", "ROBOT_ARM", "SENSORS", "Sensor", "Execution", "FAILURE_CAUSES", "FingerTiming", "GraspOutcome", "HandDesign",
-    "HandModel", "Intrinsics", "MISSED", "NO_PLAN", "ObjectSpec", "PUSHED", "Part", "Placement", "SLIPPED", "SR300", "STRUCK",
+    "HandModel", "HandReading", "Intrinsics", "MISSED", "NO_PLAN", "ObjectSpec", "PUSHED", "Part", "Placement", "SLIPPED", "SR300", "STRUCK",
     "Scene", "THESIS_OBJECTS", "TIMINGS", "TrialRecord", "Workspace", "build_hand", "build_scene", "derive_body", "execute_grasp",
     "fingertip_path_error", "fingertip_paths", "hand_pose_from_matrix", "mesh_object", "object_spec", "object_truth",
     "pose_matrix", "render", "render_view", "run_clearing", "run_trial", "scripted_grasp", "sensor_named", "tilted_view",

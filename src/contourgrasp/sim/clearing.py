@@ -15,9 +15,10 @@ failed, at most :data:`ATTEMPTS_PER_OBJECT` attempts per object in the scene. Ea
    Nothing planned ends the run;
 3. the grasp is executed on the object the plan is on (the one most of the plan's pixels see), the
    others its neighbours; the closed hand carries what it holds out of view;
-4. the closed hand's joint readings tell whether it holds something
-   (:func:`~contourgrasp.sim.detect.fingers_hold`: a finger stopped short of where it closes on nothing),
-   as a robot's encoders tell it. Told it holds: whatever it holds is put away
+4. the closed hand's readings tell whether it holds something
+   (:func:`~contourgrasp.sim.detect.hand_holds`: a finger stopped short of where it closes on nothing, or
+   a load on the wrist),
+   as a robot's encoders and wrist sensor tell it. Told it holds: whatever it holds is put away
    (:meth:`~contourgrasp.sim.scene.Scene.remove`). Told empty: the hand leaves, and the grasp that failed is
    remembered on its object (:class:`~contourgrasp.synthesis.GraspMemory`);
 5. an object knocked off the table (or out of the bin) is lost: removed, not cleared.
@@ -25,13 +26,13 @@ failed, at most :data:`ATTEMPTS_PER_OBJECT` attempts per object in the scene. Ea
 What counts, as in VGN: an attempt succeeds when the hand has taken an object off the table -- after
 the lift, the hold and the carry away, an object is in the hand (above the table's top, no longer over
 it). Touching a neighbour while closing is not a failure here (a trial's ``hit`` is); a descent stopped
-by a touch is, as always. An object is cleared when the joints told the attempt that held it a success
-and it was put away; one the hand held but the joints missed falls where the hand opened, off the table,
+by a touch is, as always. An object is cleared when the hand told the attempt that held it a success
+and it was put away; one the hand held but did not tell falls where the hand opened, off the table,
 and is lost. The run succeeds when every object was cleared; when it does not, its cause is the last
 failed attempt's, "no feasible plan" when nothing could be planned, and otherwise (every attempt held
 something, yet an object was lost off the table) the hit of a neighbour.
 
-Why the joints and not a new picture, as :func:`~contourgrasp.sim.trial.run_trial`'s attempts: among
+Why the hand and not a new picture too, as :func:`~contourgrasp.sim.trial.run_trial`'s attempts: among
 several objects, a lifted one uncovers what stood behind it (a neighbour, a bin wall), and the picture
 then shows something standing where it stood: a success told a failure (docs/regrasp.md, "Clearing a
 table", has the counts). Whatever the hand holds after the carry away is off the table, which is all
@@ -53,7 +54,7 @@ from ..hand import Hand
 from ..synthesis import GraspMemory
 from ..validation import choice
 from .clutter import deepest_pixel
-from .detect import fingers_hold
+from .detect import hand_holds
 from .render import DEFAULT_SENSOR, Sensor, render, tilted_view, truth_labels
 from .scene import Camera, Workspace
 from .tendon_hand import HandDesign
@@ -135,14 +136,14 @@ def run_clearing(object_spec, *, seed: int, planner, pool, scene_kind: str = "cl
 
 
 def _pick(scene, planned, execution) -> tuple[dict, list[int], bool]:
-    """Execute a plan on the object it is on, carry away what the hand holds, tell it from the joints, put it away
+    """Execute a plan on the object it is on, carry away what the hand holds, tell it from the hand, put it away
     when told held, and park the hand (what it still holds falls where it is): (the record's fields of the
-    execution, the objects truly held, whether the joints told something held)."""
+    execution, the objects truly held, whether the hand told something held)."""
     scene.retarget(planned_object(scene, planned))
     fields = execute_planned(scene, planned.T_camera_hand, planned.approach_depth, planned.grasp_height, execution)
     carry_away(scene)
     held = _held(scene)
-    told = fingers_hold(scene.finger_readings(), scene.free_closure())
+    told = hand_holds(scene.hand_reading(), scene.free_closure())
     for index in held if told else ():
         scene.remove(index)
     scene.set_hand(*PARKED, 0.0)

@@ -1,11 +1,11 @@
-"""Telling a failed grasp as a robot tells it: from a new picture and from the hand's joint readings.
+"""Telling a failed grasp as a robot tells it: from the hand's readings and a new picture.
 
 After an attempt the closed hand carries what it holds out of the camera's view
-(:func:`contourgrasp.sim.trial.run_trial` with several attempts) and a new picture is taken:
-:func:`seen_lifted` reads it as a robot's camera would -- whether the object still stands where it stood.
-:func:`fingers_hold` reads the closed hand's joints as its encoders would -- whether a finger stopped
-short of where it closes on nothing. An attempt is told a success when both say so (:func:`told_lifted`);
-neither reads the simulator's truth (docs/regrasp.md).
+(:func:`contourgrasp.sim.trial.run_trial` with several attempts). :func:`hand_holds` reads the hand as
+its encoders and a wrist force-torque sensor would -- a finger stopped short of where it closes on
+nothing, or a load on the wrist. :func:`seen_lifted` reads a new picture as a robot's camera would --
+whether the object still stands where it stood. :func:`told_lifted` combines them; neither reads the
+simulator's truth (docs/regrasp.md).
 """
 
 from __future__ import annotations
@@ -16,22 +16,26 @@ import numpy as np
 from .. import perception
 from ..errors import SegmentationError
 from ..perception.table import heights
-from ..tolerances import (DETECT_COLOUR, DETECT_CONTRAST, DETECT_REACH, DETECT_RISE, DETECT_SHARE, HOLD_READING,
-                          LIGHTNESS_WEIGHT, MIN_HEIGHT)
+from ..tolerances import (DETECT_COLOUR, DETECT_CONTRAST, DETECT_REACH, DETECT_RISE, DETECT_SHARE, HOLD_LOAD,
+                          HOLD_READING, LIGHTNESS_WEIGHT, MIN_HEIGHT)
 
 
-def told_lifted(planned, before, after, readings, free_closure, *, anywhere: bool = False) -> bool:
-    """Whether an attempt is told a success: the new picture says its object was lifted (:func:`seen_lifted`) and
-    the hand's joints say it holds something (:func:`fingers_hold`)."""
-    return fingers_hold(readings, free_closure) and seen_lifted(planned, before, after, anywhere=anywhere)
+def told_lifted(planned, before, after, reading, free_closure, *, anywhere: bool = False) -> bool:
+    """Whether an attempt is told a success: the hand holds something (:func:`hand_holds`) and, in a scene of
+    several objects, the new picture no longer shows the target where it stood (:func:`seen_lifted`); with
+    ``anywhere`` (one object: whatever the hand holds is it) the hand alone tells, and ``after`` is not read."""
+    return hand_holds(reading, free_closure) and (anywhere or seen_lifted(planned, before, after))
 
 
-def fingers_hold(readings, free_closure) -> bool:
-    """Whether a closed hand holds something: one of its finger joints ``readings`` (j,) reads at least
-    ``tolerances.HOLD_READING`` from ``free_closure`` (j,), where it stops closed on nothing -- a finger on an
-    object stops short. A hand without finger joints is never told empty."""
-    readings, free = np.asarray(readings, dtype=float), np.asarray(free_closure, dtype=float)
-    return not readings.size or bool(np.max(np.abs(readings - free)) >= HOLD_READING)
+def hand_holds(reading, free_closure) -> bool:
+    """Whether a closed hand holds something: a finger joint of ``reading``
+    (:class:`~contourgrasp.sim.scene.HandReading`) stopped at least ``tolerances.HOLD_READING`` short of where it
+    stops closed on nothing (``free_closure``'s) -- a finger on an object --, or the wrist carries at least
+    ``tolerances.HOLD_LOAD`` more than the empty hand -- an object caged in the closed hand, its fingers at
+    their limits, still weighs."""
+    joints, free = np.asarray(reading.joints, dtype=float), np.asarray(free_closure.joints, dtype=float)
+    stopped = joints.size and float(np.max(np.abs(joints - free))) >= HOLD_READING
+    return bool(stopped or reading.load - free_closure.load >= HOLD_LOAD)
 
 
 def seen_lifted(planned, before, after, *, anywhere: bool = False) -> bool:

@@ -210,6 +210,23 @@ class Placement:
     yaw: float
 
 
+@dataclass(frozen=True, eq=False)
+class HandReading:
+    """What a real hand and its wrist report: the finger joints (its encoders) and the load it carries.
+
+    Attributes
+    ----------
+    joints : (j,) float
+        Every joint below the palm, rad (m for a slide).
+    load : float
+        The force the hand's base holds up along the world's vertical, N: a wrist force-torque sensor's
+        reading (the simulated hand's own weight is compensated, so what it holds weighs on it).
+    """
+
+    joints: np.ndarray
+    load: float
+
+
 class Scene:
     """A MuJoCo model and state of table, object, hand and camera (mutable: it is simulated).
 
@@ -375,13 +392,16 @@ class Scene:
         tilt and roll), as :meth:`command` takes them."""
         return np.array(self.data.qpos[self._base_qpos], dtype=float)
 
-    def finger_readings(self) -> np.ndarray:
-        """(j,) float: the hand's finger joints now (every joint below the palm), as a real hand's encoders read them."""
-        return self.data.qpos[self._finger_qpos].copy()
+    def hand_reading(self) -> HandReading:
+        """What the hand and its wrist report now (:class:`HandReading`)."""
+        return self._reading(self.data)
 
-    def free_closure(self) -> np.ndarray:
-        """(j,) float: :meth:`finger_readings` of the hand closed on nothing -- closed for ``FREE_CLOSURE_TIME`` s far
-        above the table, in a copy of the scene (computed once)."""
+    def _reading(self, data) -> HandReading:
+        return HandReading(data.qpos[self._finger_qpos].copy(), float(data.actuator_force[self._base_ctrl[2]]))
+
+    def free_closure(self) -> HandReading:
+        """:meth:`hand_reading` of the hand closed on nothing -- closed for ``FREE_CLOSURE_TIME`` s far above the
+        table, in a copy of the scene (computed once): where its joints stop, and the wrist's load to tare."""
         if self._free_closure is None:
             data = copy.copy(self.data)
             base = self.hand_base()
@@ -392,8 +412,8 @@ class Scene:
             data.ctrl[actuators] = closed
             with mujoco_warnings():
                 mujoco.mj_step(self.model, data, nstep=round(FREE_CLOSURE_TIME / self.model.opt.timestep))
-            self._free_closure = data.qpos[self._finger_qpos].copy()
-        return self._free_closure.copy()
+            self._free_closure = self._reading(data)
+        return self._free_closure
 
     def set_hand(self, x: float, y: float, z: float, yaw: float, closing: float = 0.0, *, tilt: float = 0.0,
                  roll: float = 0.0) -> None:

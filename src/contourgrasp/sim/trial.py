@@ -196,8 +196,8 @@ class TrialRecord:
         Seconds of wall time for the whole trial (scene, picture, plan, simulation).
     outcomes, detected : tuple of bool
         With several attempts (:func:`run_trial`'s ``attempts``), per attempt made: whether it truly
-        succeeded, and whether it was told a success -- the new frame after it and the hand's joint readings
-        (:func:`~contourgrasp.sim.detect.told_lifted`); empty with one.
+        succeeded, and whether it was told a success -- the hand's readings and, among several objects, the
+        new frame after it (:func:`~contourgrasp.sim.detect.told_lifted`); empty with one.
         The other fields are the last attempt's, ``plan_time`` the attempts' sum.
     scene_objects, cleared : int or None
         Of a run clearing a table (:func:`~contourgrasp.sim.clearing.run_clearing`): the objects in the
@@ -236,10 +236,10 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
               scene_kind: str = "single", pool=(), robot: bool = False, attempts: int = 1) -> TrialRecord:
     """Place the object (seeded), take an RGB-D picture, plan, execute, and record the outcome.
 
-    With ``attempts`` above 1, a failure is told as a real robot would tell it -- a new picture after
-    the hold, in which the object still stands where it stood, or the closed hand's joints at the
-    positions they reach on nothing (:func:`~contourgrasp.sim.detect.told_lifted`), not the
-    simulator's truth -- and then the hand opens and leaves, the scene settles as it is, a new
+    With ``attempts`` above 1, a failure is told as a real robot would tell it -- after the hold the
+    closed hand carries what it holds away and reports nothing held (its joints where they stop on
+    nothing, no load on its wrist), or, among several objects, a new picture shows the target still
+    where it stood (:func:`~contourgrasp.sim.detect.told_lifted`); not the simulator's truth -- and then the hand opens and leaves, the scene settles as it is, a new
     picture is taken and the planner tries again, remembering the grasps that failed (its ``plan``
     takes ``memory``: :class:`~contourgrasp.synthesis.GraspMemory`), until an attempt is told a
     success or ``attempts`` were made. The record is the last attempt's, with every attempt's
@@ -312,9 +312,10 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
             detected.append(False)
             break
         carry_away(scene)
-        after = render(scene, sensor=sensor, seed=noise_seed(seed, attempt, 1))
-        detected.append(told_lifted(planned, (rgb, depth), after, scene.finger_readings(), scene.free_closure(),
-                                    anywhere=scene_kind == "single"))
+        alone = scene_kind == "single"
+        after = None if alone else render(scene, sensor=sensor, seed=noise_seed(seed, attempt, 1))
+        detected.append(told_lifted(planned, (rgb, depth), after, scene.hand_reading(), scene.free_closure(),
+                                    anywhere=alone))
         if detected[-1]:
             break
         memory = memory.with_failure(planned.metric.contour_xy, planned.pose, approach=planned.approach)
