@@ -55,11 +55,11 @@ from ..synthesis import GraspMemory
 from ..validation import choice
 from .clutter import deepest_pixel
 from .detect import hand_holds
-from .render import DEFAULT_SENSOR, Sensor, render, tilted_view, truth_labels
+from .render import DEFAULT_SENSOR, Sensor, render, truth_labels
 from .scene import Camera, Workspace
 from .tendon_hand import HandDesign
 from .trial import (HIT, NO_PLAN, NO_PLAN_FIELDS, PARKED, SETTLE_AFTER_FAILURE, Execution, TrialRecord, carry_away, noise_seed,
-                    execute_planned, trial_scene, with_wrist)
+                    execute_planned, trial_scene)
 
 #: A run stops after this many attempts in a row told failed (VGN's ``consecutive_failures``).
 FAILURES_IN_A_ROW = 2
@@ -94,11 +94,8 @@ def run_clearing(object_spec, *, seed: int, planner, pool, scene_kind: str = "cl
     if not hasattr(planner, "plan"):
         raise SimulationError("clearing a table needs a planner with a plan method that takes memory= "
                               "(contourgrasp.sim.planners)")
-    hand, design = with_wrist(planner, hand, design)
-    scene = trial_scene(object_spec, seed=seed, scene_kind=scene_kind, pool=pool, hand=hand, design=design,
-                        timing=timing, camera=camera, workspace=workspace, robot=robot)
-    if tilt is not None:
-        scene.view = tilted_view(tilt, camera.height)
+    scene = trial_scene(object_spec, seed=seed, scene_kind=scene_kind, pool=pool, planner=planner, tilt=tilt,
+                        hand=hand, design=design, timing=timing, camera=camera, workspace=workspace, robot=robot)
     failed, outcomes, detected, cleared, in_a_row, plan_time = (), [], [], 0, 0, 0.0
     fields, plan_error, ended, failure = dict(NO_PLAN_FIELDS), None, ATTEMPT_LIMIT, HIT
     for attempt in range(ATTEMPTS_PER_OBJECT * len(scene.objects)):

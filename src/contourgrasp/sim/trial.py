@@ -294,11 +294,8 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
     if attempts > 1 and not hasattr(planner, "plan"):
         raise SimulationError("several attempts need a planner with a plan method that takes memory= "
                               "(contourgrasp.sim.planners)")
-    hand, design = with_wrist(planner, hand, design)
-    scene = trial_scene(object_spec, seed=seed, scene_kind=scene_kind, pool=pool, hand=hand, design=design,
-                        timing=timing, camera=camera, workspace=workspace, robot=robot)
-    if tilt is not None:
-        scene.view = tilted_view(tilt, camera.height)
+    scene = trial_scene(object_spec, seed=seed, scene_kind=scene_kind, pool=pool, planner=planner, tilt=tilt,
+                        hand=hand, design=design, timing=timing, camera=camera, workspace=workspace, robot=robot)
     memory, outcomes, detected, plan_time = GraspMemory(), [], [], 0.0
     for attempt in range(attempts):
         rgb, depth = render(scene, sensor=sensor, seed=seed if attempt == 0 else noise_seed(seed, attempt, 0))
@@ -399,12 +396,21 @@ def with_wrist(planner, hand, design: HandDesign):
     return hand, replace(design, wrist=True)
 
 
-def trial_scene(object_spec, *, seed: int, scene_kind: str = "single", pool=(), **options) -> Scene:
+def trial_scene(object_spec, *, seed: int, scene_kind: str = "single", pool=(), planner=None,
+                tilt: float | None = None, hand: Hand | str = "five-finger-linear", design: HandDesign = HandDesign(),
+                **options) -> Scene:
     """The settled scene of a trial: :func:`~contourgrasp.sim.scene.build_scene` for ``"single"``, else
-    :func:`~contourgrasp.sim.clutter.build_clutter` (``pool``: its neighbours); ``options`` go to either."""
+    :func:`~contourgrasp.sim.clutter.build_clutter` (``pool``: its neighbours); ``options`` go to either. The
+    hand has the wrist ``planner`` needs (:func:`with_wrist`); ``tilt``: the picture's camera, as
+    :func:`run_trial`'s."""
+    hand, design = with_wrist(planner, hand, design)
     if scene_kind == "single":
-        return build_scene(object_spec, seed=seed, **options)
-    return build_clutter(object_spec, pool, kind=scene_kind, seed=seed, **options)
+        scene = build_scene(object_spec, seed=seed, hand=hand, design=design, **options)
+    else:
+        scene = build_clutter(object_spec, pool, kind=scene_kind, seed=seed, hand=hand, design=design, **options)
+    if tilt is not None:
+        scene.view = tilted_view(tilt, scene.camera.height)
+    return scene
 
 
 def hand_pose_from_matrix(transform) -> tuple[float, float, float]:
