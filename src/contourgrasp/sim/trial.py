@@ -236,10 +236,10 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
               scene_kind: str = "single", pool=(), robot: bool = False, attempts: int = 1) -> TrialRecord:
     """Place the object (seeded), take an RGB-D picture, plan, execute, and record the outcome.
 
-    With ``attempts`` above 1, a failure is told as a real robot would tell it -- after the hold the
-    closed hand carries what it holds away and reports nothing held (its joints where they stop on
-    nothing, no load on its wrist), or, among several objects, a new picture shows the target still
-    where it stood (:func:`~contourgrasp.sim.detect.told_lifted`); not the simulator's truth -- and then the hand opens and leaves, the scene settles as it is, a new
+    With ``attempts`` above 1, a failure is told as a real robot would tell it -- at the end of the hold
+    the closed hand reports nothing held (its joints where they stop on nothing, no load on its wrist),
+    or, among several objects, a new picture taken after the hand carried what it holds away shows the
+    target still where it stood (:func:`~contourgrasp.sim.detect.told_lifted`); not the simulator's truth -- and then the hand opens and leaves, the scene settles as it is, a new
     picture is taken and the planner tries again, remembering the grasps that failed (its ``plan``
     takes ``memory``: :class:`~contourgrasp.synthesis.GraspMemory`), until an attempt is told a
     success or ``attempts`` were made. The record is the last attempt's, with every attempt's
@@ -308,11 +308,10 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
         if planned is None:  # no plan: nothing more to try
             detected.append(False)
             break
+        reading, alone = scene.hand_reading(), scene_kind == "single"  # read when the outcome is judged: the hold's end
         carry_away(scene)
-        alone = scene_kind == "single"
         after = None if alone else render(scene, sensor=sensor, seed=noise_seed(seed, attempt, 1))
-        detected.append(told_lifted(planned, (rgb, depth), after, scene.hand_reading(), scene.free_closure(),
-                                    anywhere=alone))
+        detected.append(told_lifted(planned, (rgb, depth), after, reading, scene.free_closure(), anywhere=alone))
         if detected[-1]:
             break
         memory = memory.with_failure(planned.metric.contour_xy, planned.pose, approach=planned.approach)
