@@ -239,6 +239,9 @@ HOLD_READING = 0.01
 #: ... or when its wrist carries at least this much more than the empty hand, N (2 g; an object caged in the closed
 #: hand, every finger at its limit, still weighs: the bench's 12 g toy airplane 0.12 N, the empty hand 0.000).
 HOLD_LOAD = 0.02
+#: A hand is read once no finger joint turns faster than this, rad/s (sim.scene.Scene.hand_reading): a finger still
+#: closing is not yet stopped by anything.
+HOLD_SPEED = 0.01
 #: At most this many attempts per trial (bounds the work a bench can ask for).
 MAX_ATTEMPTS = 5
 

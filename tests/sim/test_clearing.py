@@ -7,7 +7,7 @@ import pytest
 
 from contourgrasp import load_hand
 from contourgrasp.errors import NoFeasibleGrasp, SimulationError
-from contourgrasp.sim import HIT, MISSED, NO_PLAN, HandReading, build_clutter, build_scene, execute_grasp, run_clearing, scripted_grasp, truth_labels
+from contourgrasp.sim import HIT, MISSED, NO_PLAN, STRUCK, HandReading, build_clutter, pose_matrix, build_scene, execute_grasp, run_clearing, scripted_grasp, truth_labels
 from contourgrasp.sim.clearing import CLEARED, FAILED_IN_A_ROW, FAILURES_IN_A_ROW, MAX_CANDIDATES, NOTHING_PLANNED
 from contourgrasp.sim.detect import hand_holds
 from contourgrasp.sim.trial import carry_away
@@ -143,3 +143,18 @@ def test_clearing_needs_several_objects_and_a_planner_that_remembers():
         run_clearing("can", seed=0, planner=make_planner("default", HAND), pool=POOL, scene_kind="single")
     with pytest.raises(SimulationError, match="plan method"):
         run_clearing("can", seed=0, planner=lambda rgb, depth, intrinsics: None, pool=POOL)
+
+
+def test_a_hand_told_to_close_is_read_once_its_fingers_are_still_and_a_grasp_struck_on_the_way_never_closed():
+    scene = build_scene("can", seed=0)
+    scene.set_hand(0.0, 0.0, PARK_HEIGHT, 0.0, closing=1.0)
+    scene.step(0.05)  # the fingers are closing
+    started = scene.time
+    reading = scene.hand_reading()
+    assert scene.time > started and np.max(np.abs(reading.joints - scene.free_closure().joints)) < HOLD_READING
+    assert scene.closed
+    struck = build_scene("can", seed=4)
+    centre = struck.camera.from_world(struck.object_com())[:2]
+    middle_start = np.array([0.0, 0.215])  # the middle finger of five-finger-linear comes down on the can
+    outcome = execute_grasp(struck, pose_matrix(*(centre - middle_start), 0.0), struck.camera.height - 0.056)
+    assert outcome.cause == STRUCK and not struck.closed

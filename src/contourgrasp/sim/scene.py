@@ -60,7 +60,7 @@ from ..errors import SimulationError  # noqa: E402
 from ..hand import Hand  # noqa: E402
 from ..perception import Intrinsics  # noqa: E402
 from ..io.hand_file import load_hand  # noqa: E402
-from ..tolerances import NEIGHBOUR_LIFT, SENSOR_RANGE  # noqa: E402
+from ..tolerances import HOLD_SPEED, NEIGHBOUR_LIFT, SENSOR_RANGE  # noqa: E402
 from .tendon_hand import BASE_JOINTS, HAND_BIT, TABLE_BIT, WRIST_JOINTS, HandDesign, HandModel, build_hand  # noqa: E402
 from .objects import ObjectSpec, Part, object_spec  # noqa: E402
 
@@ -96,8 +96,11 @@ R_WORLD_CAMERA = np.diag([1.0, -1.0, -1.0])
 #: Where :meth:`Scene.remove` parks an object (world x, y, z, m; the next one a metre farther along x), far from
 #: the table and every camera's view, and the damping (N s/m) of its free joint that holds it there.
 REMOVED_AT, REMOVED_DAMPING = (10.0, 10.0, -5.0), 1e6
-#: Seconds the hand closes on nothing for :meth:`Scene.free_closure`.
-FREE_CLOSURE_TIME = 1.5
+#: Seconds the hand closes on nothing for :meth:`Scene.free_closure`, and at most how much longer it may take to
+#: be still (the Inspire's fingers take about 5 s).
+FREE_CLOSURE_TIME, FREE_CLOSURE_WAIT = 1.5, 10.0
+#: At most this long (s) :meth:`Scene.hand_reading` waits for the fingers to be still.
+READ_WAIT = 5.0
 #: Height from which the neighbours of a scene of several objects are dropped, m.
 DROP_HEIGHT = 0.003
 #: Half extents (x, y) of the table top, m.
@@ -249,6 +252,9 @@ class Scene:
         Where the planner's picture is taken from when not from ``camera`` (a tilted camera).
     target : int
         Which object is the target, in :attr:`objects`' order (0, body ``object``, until :meth:`retarget`).
+    closed : bool
+        Whether the hand was last commanded fully closed (a robot knows what it commanded: a grasp stopped
+        by a touch on the way down never closed).
 
     Every object but the target and those taken out (:meth:`remove`) is a neighbour: the hand must not touch it.
     """
@@ -268,8 +274,8 @@ class Scene:
         self._base_ctrl = np.array([model.actuator(j).id for j in joints])
         self._base_dofs = np.array([model.joint(j).dofadr[0] for j in joints])
         below_palm = [j for j in range(model.njnt) if _descends(model, model.jnt_bodyid[j], self._palm)]
-        self._finger_qpos = model.jnt_qposadr[below_palm]
-        self._free_closure = None
+        self._finger_qpos, self._finger_dofs = model.jnt_qposadr[below_palm], model.jnt_dofadr[below_palm]
+        self._free_closure, self.closed = None, False
         synergy = getattr(hand, "synergy", None)  # a mounted hand model (handmodels.mount) closes many actuators
         self._closing = synergy(model) if synergy else (np.array([model.actuator("flexion").id]), np.zeros(1),
                                                         np.ones(1))
@@ -393,15 +399,26 @@ class Scene:
         return np.array(self.data.qpos[self._base_qpos], dtype=float)
 
     def hand_reading(self) -> HandReading:
-        """What the hand and its wrist report now (:class:`HandReading`)."""
+        """What the hand and its wrist report once its fingers are still (:class:`HandReading`): the scene is
+        stepped, the hand held where it is, until no finger joint moves faster than ``HOLD_SPEED``, at most
+        ``READ_WAIT`` s -- a slow hand (the Inspire's fingers take seconds to close) is read when it has stopped."""
+        self._until_still(self.data, READ_WAIT)
         return self._reading(self.data)
+
+    def _until_still(self, data, longest: float) -> None:
+        waited = 0.0
+        while waited < longest and np.max(np.abs(data.qvel[self._finger_dofs]), initial=0.0) > HOLD_SPEED:
+            with mujoco_warnings():
+                mujoco.mj_step(self.model, data, nstep=round(REST_CHECK / self.model.opt.timestep))
+            waited += REST_CHECK
 
     def _reading(self, data) -> HandReading:
         return HandReading(data.qpos[self._finger_qpos].copy(), float(data.actuator_force[self._base_ctrl[2]]))
 
     def free_closure(self) -> HandReading:
         """:meth:`hand_reading` of the hand closed on nothing -- closed for ``FREE_CLOSURE_TIME`` s far above the
-        table, in a copy of the scene (computed once): where its joints stop, and the wrist's load to tare."""
+        table and on until its fingers are still (at most ``FREE_CLOSURE_WAIT`` s more), in a copy of the scene
+        (computed once): where its joints stop, and the wrist's load to tare."""
         if self._free_closure is None:
             data = copy.copy(self.data)
             base = self.hand_base()
@@ -412,6 +429,7 @@ class Scene:
             data.ctrl[actuators] = closed
             with mujoco_warnings():
                 mujoco.mj_step(self.model, data, nstep=round(FREE_CLOSURE_TIME / self.model.opt.timestep))
+            self._until_still(data, FREE_CLOSURE_WAIT)
             self._free_closure = self._reading(data)
         return self._free_closure
 
@@ -432,6 +450,7 @@ class Scene:
         self.data.ctrl[self._base_ctrl] = self._base_target(base_target)
         actuators, open_, closed = self._closing
         self.data.ctrl[actuators] = open_ + closing * (closed - open_)
+        self.closed = closing >= 1.0
 
     def _base_target(self, base_target) -> np.ndarray:
         """The base joints' values of (x, y, z, yaw[, tilt, roll]): tilt and roll 0 when left out.

@@ -308,10 +308,12 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
         if planned is None:  # no plan: nothing more to try
             detected.append(False)
             break
-        reading, alone = scene.hand_reading(), scene_kind == "single"  # read when the outcome is judged: the hold's end
+        closed, alone = scene.closed, scene_kind == "single"  # not closed: the descent stopped on a touch
+        reading = scene.hand_reading() if closed else None  # read when the outcome is judged: the hold's end
         carry_away(scene)
         after = None if alone else render(scene, sensor=sensor, seed=noise_seed(seed, attempt, 1))
-        detected.append(told_lifted(planned, (rgb, depth), after, reading, scene.free_closure(), anywhere=alone))
+        detected.append(closed and told_lifted(planned, (rgb, depth), after, reading, scene.free_closure(),
+                                               anywhere=alone))
         if detected[-1]:
             break
         memory = memory.with_failure(planned.metric.contour_xy, planned.pose, approach=planned.approach)
