@@ -14,7 +14,8 @@ reported beside them, never chosen on.
 
 Usage::
 
-    .venv/bin/python benchmarks/early_touch.py OUT/trials.jsonl [OUT2/trials.jsonl ...] [--rules 0.2:1,0.3:1,0.3:2,0.5:2]
+    .venv/bin/python benchmarks/early_touch.py OUT/trials.jsonl [OUT2/trials.jsonl ...] \
+        [--rules 0.2:1,0.3:1,0.3:2,0.5:2]
 """
 
 import argparse
@@ -51,7 +52,8 @@ def main(argv=None) -> int:
     trials = [json.loads(line) for path in args.journals for line in path.read_text().splitlines()[1:] if line]
     touched = [t for t in trials if t["first_contact"]]
     groups = sorted({(t["planner"], object_set(t["object"], sets)) for t in touched})
-    print("| planner | set | trials touched | lifted | " + " | ".join(f"abort {t:g} s, <= {k}" for t, k in rules) + " |")
+    heads = " | ".join(f"abort {t:g} s, <= {k}" for t, k in rules)
+    print(f"| planner | set | trials touched | lifted | {heads} |")
     print("|---|---|---:|---:|" + "---:|" * len(rules))
     for planner, group in groups:
         own = [t for t in touched if t["planner"] == planner and object_set(t["object"], sets) == group]
@@ -59,7 +61,8 @@ def main(argv=None) -> int:
         for seconds, fingers in rules:
             cut = [t for t in own if aborted(t, seconds, fingers)]
             cells.append(f"{len(cut)} ({sum(t['success'] for t in cut)} lifted)")
-        print(f"| {Path(planner).stem} | {group} | {len(own)} | {sum(t['success'] for t in own)} | " + " | ".join(cells) + " |")
+        lifted = sum(t["success"] for t in own)
+        print(f"| {Path(planner).stem} | {group} | {len(own)} | {lifted} | {' | '.join(cells)} |")
     return 0
 
 

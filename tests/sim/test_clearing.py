@@ -7,7 +7,8 @@ import pytest
 
 from contourgrasp import load_hand
 from contourgrasp.errors import NoFeasibleGrasp, SimulationError
-from contourgrasp.sim import HIT, MISSED, NO_PLAN, STRUCK, HandReading, build_clutter, pose_matrix, build_scene, execute_grasp, run_clearing, scripted_grasp, truth_labels
+from contourgrasp.sim import (HIT, MISSED, NO_PLAN, STRUCK, HandReading, build_clutter, build_scene, execute_grasp,
+                              pose_matrix, run_clearing, scripted_grasp, truth_labels)
 from contourgrasp.sim.clearing import CLEARED, FAILED_IN_A_ROW, FAILURES_IN_A_ROW, MAX_CANDIDATES, NOTHING_PLANNED
 from contourgrasp.sim.detect import hand_holds
 from contourgrasp.sim.trial import carry_away

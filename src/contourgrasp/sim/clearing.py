@@ -58,8 +58,8 @@ from .detect import hand_holds
 from .render import DEFAULT_SENSOR, Sensor, render, truth_labels
 from .scene import Camera, Workspace
 from .tendon_hand import HandDesign
-from .trial import (HIT, NO_PLAN, NO_PLAN_FIELDS, PARKED, SETTLE_AFTER_FAILURE, Execution, TrialRecord, carry_away, noise_seed,
-                    execute_planned, trial_scene)
+from .trial import (HIT, NO_PLAN, NO_PLAN_FIELDS, PARKED, SETTLE_AFTER_FAILURE, Execution, TrialRecord, carry_away,
+                    execute_planned, noise_seed, trial_scene)
 
 #: A run stops after this many attempts in a row told failed (VGN's ``consecutive_failures``).
 FAILURES_IN_A_ROW = 2
