@@ -25,6 +25,16 @@ def test_two_workers_give_the_serial_trials_bit_for_bit(serial_bench, tmp_path):
     assert [line for line in table if "time" not in line] == [line for line in serial if "time" not in line]
 
 
+def test_clearing_tables_in_two_workers_gives_the_serial_runs(tmp_path):
+    clear = ["bench", "--objects", "can,case", "--scene", "clutter", "--protocol", "clear", "--trials", "1",
+             "--planners", "default"]
+    assert main([*clear, "--workers", "1", "--out", str(tmp_path / "serial")]) == 0
+    assert main([*clear, "--workers", "2", "--out", str(tmp_path / "two")]) == 0
+    runs = trials_without_times(tmp_path / "two")
+    assert runs == trials_without_times(tmp_path / "serial") and all(r["scene_objects"] >= 2 for r in runs)
+    assert "## Clearing the table" in (tmp_path / "two" / "table.md").read_text()
+
+
 def test_a_trial_runs_with_numpys_blas_on_one_thread(monkeypatch):
     from threadpoolctl import threadpool_limits
 
