@@ -219,22 +219,9 @@ MIN_FLAT_HEIGHT = 0.0005
 #: mask; the whole image is searched only when the evidence reaches that window's edge.
 FLAT_WINDOW_PX = 96
 
-#: The bench's several attempts (sim.trial.run_trial): a picture after the hold says the object is still where it stood
-#: when, within this distance (m, on the table) of its former pixels ...
-DETECT_REACH = 0.05
-#: ... at least this share as many pixels stand on the support ...
-DETECT_SHARE = 0.5
-#: ... or that share of its former pixels keep their colour within this CIELAB distance (OpenCV's 8-bit scale): it has
-#: not moved (the sensor's picture noise is in depth; the bench's colour is exact).
-DETECT_COLOUR = 12.0
-#: ... which is told only of an object whose colour lies at least this far (CIELAB) from what surrounds it: a ball as
-#: light as the table would look unmoved once lifted.
-DETECT_CONTRAST = 30.0
-#: ... lower than its former top plus this (m): held at the lift's height (0.15 m) it stands higher.
-DETECT_RISE = 0.05
-#: A closed hand holds something when one of its finger joints reads at least this far (rad, or m for a slide) from
-#: where it stops closed on nothing: measured on clutter runs, an empty hand's joints lie within 0.0003 of it and a
-#: squeezed object's stop at least 0.02 short (sim.detect.hand_holds) ...
+#: The bench's several attempts and clearing (sim.detect.hand_holds): a closed hand holds something when one of its
+#: finger joints reads at least this far (rad, or m for a slide) from where it stops closed on nothing: measured on
+#: clutter runs, an empty hand's joints lie within 0.0003 of it and a squeezed object's stop at least 0.02 short ...
 HOLD_READING = 0.01
 #: ... or when its wrist carries at least this much more than the empty hand, N (2 g; an object caged in the closed
 #: hand, every finger at its limit, still weighs: the bench's 12 g toy airplane 0.12 N, the empty hand 0.000).

@@ -178,7 +178,7 @@ class _FirstMisses:
         return planned.T_camera_hand, planned.approach_depth, planned.grasp_height
 
 
-def test_a_miss_is_told_from_the_next_picture_and_the_next_attempt_lifts_the_can():
+def test_a_miss_is_told_by_the_hand_and_the_next_attempt_lifts_the_can():
     record = run_trial("can", seed=1, planner=_FirstMisses(1), attempts=3)
     assert record.outcomes == (False, True) and record.detected == (False, True)
     assert record.success and record.cause is None

@@ -10,7 +10,7 @@
 * :mod:`~contourgrasp.sim.render` -- RGB-D pictures by ray casting
 * :mod:`~contourgrasp.sim.trial` -- grasp execution and trials
 * :mod:`~contourgrasp.sim.clearing` -- clearing a table: the clutter-removal protocol (``bench --protocol clear``)
-* :mod:`~contourgrasp.sim.detect` -- telling a failed grasp from the hand's readings and a new picture (`told_lifted`)
+* :mod:`~contourgrasp.sim.detect` -- telling a failed grasp from what the closed hand reports (`hand_holds`)
 * :mod:`~contourgrasp.sim.measure` -- fingertip paths against the preset
 * :mod:`~contourgrasp.sim.planners` -- the library's pipeline as trial planners, and two baselines
 * :mod:`~contourgrasp.sim.bench` -- Table 4.4 as a benchmark (``contourgrasp bench``), with its figures

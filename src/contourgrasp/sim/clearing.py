@@ -32,11 +32,10 @@ and is lost. The run succeeds when every object was cleared; when it does not, i
 failed attempt's, "no feasible plan" when nothing could be planned, and otherwise (every attempt held
 something, yet an object was lost off the table) the hit of a neighbour.
 
-Why the hand and not a new picture too, as :func:`~contourgrasp.sim.trial.run_trial`'s attempts: among
-several objects, a lifted one uncovers what stood behind it (a neighbour, a bin wall), and the picture
-then shows something standing where it stood: a success told a failure (docs/regrasp.md, "Clearing a
-table", has the counts). Whatever the hand holds after the carry away is off the table, which is all
-clearing asks.
+Why the hand and not a new picture: among several objects, a lifted one uncovers what stood behind it
+(a neighbour, a bin wall), and the picture then shows something standing where it stood -- a success
+told a failure (docs/studies.md, "Clearing a table", has the counts). Whatever the hand holds after the
+carry away is off the table, which is all clearing asks.
 """
 
 from __future__ import annotations

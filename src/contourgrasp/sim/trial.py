@@ -76,7 +76,7 @@ from ..synthesis import GraspMemory
 from ..tolerances import MAX_ATTEMPTS
 from ..validation import integer
 from .clutter import build_clutter, target_pixel
-from .detect import told_lifted
+from .detect import hand_holds
 from .tendon_hand import HandDesign
 from .render import DEFAULT_SENSOR, Sensor, render, tilted_view
 from .scene import R_WORLD_CAMERA, Camera, Scene, Workspace, base_angles, build_scene
@@ -102,8 +102,8 @@ UPWARD_APPROACH = 1e-3
 VERTICAL_APPROACH = math.radians(5.0)
 #: Seconds the scene settles after a failed attempt, the hand parked, before the next picture.
 SETTLE_AFTER_FAILURE = 0.5
-#: After an attempt the closed hand is carried this far (m) along the world's y in this many seconds, out of the
-#: camera's view with what it holds, before the picture that tells whether it failed.
+#: After an attempt the closed hand is carried this far (m) along the world's y in this many seconds, off the table and
+#: out of the camera's view with what it holds.
 CARRY_AWAY, CARRY_TIME = 0.7, 1.0
 #: Angle of the hand's x axis from the object's x axis in :func:`scripted_grasp`, rad.
 SCRIPTED_TILT = math.radians(20.0)
@@ -196,8 +196,8 @@ class TrialRecord:
         Seconds of wall time for the whole trial (scene, picture, plan, simulation).
     outcomes, detected : tuple of bool
         With several attempts (:func:`run_trial`'s ``attempts``), per attempt made: whether it truly
-        succeeded, and whether it was told a success -- the hand's readings and, among several objects, the
-        new frame after it (:func:`~contourgrasp.sim.detect.told_lifted`); empty with one.
+        succeeded, and whether the hand told it a success (:func:`~contourgrasp.sim.detect.hand_holds`); empty
+        with one.
         The other fields are the last attempt's, ``plan_time`` the attempts' sum.
     scene_objects, cleared : int or None
         Of a run clearing a table (:func:`~contourgrasp.sim.clearing.run_clearing`): the objects in the
@@ -237,10 +237,10 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
     """Place the object (seeded), take an RGB-D picture, plan, execute, and record the outcome.
 
     With ``attempts`` above 1, a failure is told as a real robot would tell it -- at the end of the hold
-    the closed hand reports nothing held (its joints where they stop on nothing, no load on its wrist),
-    or, among several objects, a new picture taken after the hand carried what it holds away shows the
-    target still where it stood (:func:`~contourgrasp.sim.detect.told_lifted`); not the simulator's truth -- and then the hand opens and leaves, the scene settles as it is, a new
-    picture is taken and the planner tries again, remembering the grasps that failed (its ``plan``
+    the closed hand reports nothing held: its joints where they stop on nothing and no load on its wrist
+    (:func:`~contourgrasp.sim.detect.hand_holds`), or it never closed (the descent stopped on a touch); not
+    the simulator's truth -- and then the hand carries what it holds away, opens and leaves, the scene
+    settles as it is, a new picture is taken and the planner tries again, remembering the grasps that failed (its ``plan``
     takes ``memory``: :class:`~contourgrasp.synthesis.GraspMemory`), until an attempt is told a
     success or ``attempts`` were made. The record is the last attempt's, with every attempt's
     true and told outcome (``outcomes``, ``detected``).
@@ -308,12 +308,9 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
         if planned is None:  # no plan: nothing more to try
             detected.append(False)
             break
-        closed, alone = scene.closed, scene_kind == "single"  # not closed: the descent stopped on a touch
-        reading = scene.hand_reading() if closed else None  # read when the outcome is judged: the hold's end
+        # read when the outcome is judged, the hold's end; a descent stopped on a touch never closed
+        detected.append(scene.closed and hand_holds(scene.hand_reading(), scene.free_closure()))
         carry_away(scene)
-        after = None if alone else render(scene, sensor=sensor, seed=noise_seed(seed, attempt, 1))
-        detected.append(closed and told_lifted(planned, (rgb, depth), after, reading, scene.free_closure(),
-                                               anywhere=alone))
         if detected[-1]:
             break
         memory = memory.with_failure(planned.metric.contour_xy, planned.pose, approach=planned.approach)
@@ -327,8 +324,8 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
 
 
 def carry_away(scene) -> None:
-    """The closed hand, at its height, carried ``CARRY_AWAY`` (m) along the world's y in ``CARRY_TIME`` s, out of the
-    camera's view, with what it holds: where a robot shows the camera the table before it tries again."""
+    """The closed hand, at its height, carried ``CARRY_AWAY`` (m) along the world's y in ``CARRY_TIME`` s, off the table
+    and out of the camera's view, with what it holds: where a robot puts down what it took."""
     _move_closed(scene, scene.hand_base(), 1, CARRY_AWAY, CARRY_TIME)
 
 
