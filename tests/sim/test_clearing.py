@@ -9,6 +9,8 @@ from contourgrasp import load_hand
 from contourgrasp.errors import NoFeasibleGrasp, SimulationError
 from contourgrasp.sim import HIT, MISSED, NO_PLAN, build_clutter, render, run_clearing, truth_labels
 from contourgrasp.sim.clearing import CLEARED, FAILED_IN_A_ROW, FAILURES_IN_A_ROW, MAX_CANDIDATES, NOTHING_PLANNED
+from contourgrasp.perception import hand_opening
+from contourgrasp.pipeline import find_objects
 from contourgrasp.sim.planners import make_planner
 
 POOL = ("can-standing", "case")
@@ -30,6 +32,8 @@ def test_same_seed_same_run_in_a_bin():
 
 class _Aside:
     """The ``default`` planner with every plan moved 30 cm aside, over bare table: it closes on air."""
+
+    hand = HAND
 
     def __init__(self):
         self.planner, self.memories = make_planner("default", HAND), []
@@ -69,22 +73,30 @@ def test_a_failure_is_remembered_on_its_object_and_an_object_failed_on_is_planne
 class _NoPlan:
     """Never has a plan; keeps the target pixel of every call."""
 
+    hand = HAND
+
     def __init__(self):
         self.asked = []
 
     def plan(self, rgb, depth, intrinsics, *, memory=None, target_px=None):
-        self.asked.append((target_px, depth))
+        self.asked.append((target_px, rgb, depth, intrinsics))
         raise NoFeasibleGrasp("no plan here")
 
 
-def test_with_no_plan_every_object_in_view_is_asked_about_then_the_run_ends():
+@pytest.mark.parametrize("kind", ["clutter", "bin"])
+def test_with_no_plan_every_object_the_hand_spans_is_asked_about_then_the_run_ends(kind):
+    """In a bin, the walls (and what touches them) make a region wider than the hand opens: never asked about."""
     planner = _NoPlan()
-    record = run_clearing("can", seed=1, planner=planner, pool=POOL)
+    record = run_clearing("can", seed=1, planner=planner, pool=POOL, scene_kind=kind)
     assert record.ended == NOTHING_PLANNED and record.outcomes == () and record.cleared == 0
     assert record.plan_error == "no plan here" and record.pose is None and record.cause == NO_PLAN
-    first, *others = [pixel for pixel, _ in planner.asked]
-    assert first is None and 2 <= len(others) <= MAX_CANDIDATES and len(set(others)) == len(others)
-    scene = build_clutter("can", POOL, kind="clutter", seed=1)
+    first, *others = [pixel for pixel, *_ in planner.asked]
+    assert first is None and 1 <= len(others) <= MAX_CANDIDATES and len(set(others)) == len(others)
+    _, rgb, depth, intrinsics = planner.asked[0]
+    candidates = find_objects(depth, intrinsics, rgb=rgb).candidates
+    assert kind == "clutter" or any(c.in_view and c.extent[1] > hand_opening(HAND) for c in candidates)  # the walls
+    assert len(others) == sum(c.in_view and c.extent[1] <= hand_opening(HAND) for c in candidates)
+    scene = build_clutter("can", POOL, kind=kind, seed=1)
     labels = truth_labels(scene)
     assert all(labels[v, u] > 0 for u, v in others)  # each pixel on an object
 

@@ -7,8 +7,9 @@ failed, at most :data:`ATTEMPTS_PER_OBJECT` attempts per object in the scene. Ea
 1. a new picture (the seeded sensor noise of :func:`~contourgrasp.sim.trial.run_trial`'s attempts);
 2. the planner chooses the object itself, as a user's camera frame with no click does (the
    perception's ``"hand"`` rule). After a grasp failed, and whenever the planner's own choice has no
-   plan, it is asked about every object standing wholly in view
-   (:func:`~contourgrasp.pipeline.find_objects`, at most :data:`MAX_CANDIDATES`, each at the pixel deepest
+   plan, it is asked about every object standing wholly in view that the hand spans (its minimum-area
+   rectangle no wider than the hand opens: :func:`~contourgrasp.perception.hand_opening`;
+   :func:`~contourgrasp.pipeline.find_objects`, at most :data:`MAX_CANDIDATES`, each at the pixel deepest
    inside it), those no grasp failed on first, then those with the fewest failures, until one has a
    plan; each object is planned with the memory of the grasps that failed on it (an object is the one a
    failure was on when it stands within :data:`SAME_OBJECT_PX` of where that failure's object stood).
@@ -47,7 +48,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from .. import pipeline
+from .. import perception, pipeline
 from ..errors import ContourGraspWarning, InputError, NoFeasibleGrasp, SimulationError
 from ..hand import Hand
 from ..synthesis import GraspMemory
@@ -168,8 +169,9 @@ def _with_failure(failed: tuple[_Failed, ...], planned) -> tuple[_Failed, ...]:
 
 def _plan_next(planner, rgb, depth, intrinsics, failed: tuple[_Failed, ...]):
     """(PlannedGrasp or None, the last planning error or None, seconds): before any failure the planner's own
-    choice of object; then, or when it has no plan, every object standing wholly in view, those no grasp
-    failed on first (fewest failures first, then largest), each with its own memory."""
+    choice of object; then, or when it has no plan, every object standing wholly in view that the hand spans
+    (a bin's walls and what touches them do not), those no grasp failed on first (fewest failures first, then
+    largest), each with its own memory."""
     started, error = time.perf_counter(), None
     with warnings.catch_warnings():  # a run's record is its outcome: its perception's notes are not printed
         warnings.simplefilter("ignore", ContourGraspWarning)
@@ -182,8 +184,9 @@ def _plan_next(planner, rgb, depth, intrinsics, failed: tuple[_Failed, ...]):
             candidates = pipeline.find_objects(depth, intrinsics, rgb=rgb).candidates
         except InputError as err:
             return None, str(err), time.perf_counter() - started
-        memories = [_memory_of(c.mask, failed) for c in candidates if c.in_view][:MAX_CANDIDATES]
-        for candidate, memory in sorted(zip([c for c in candidates if c.in_view], memories), key=lambda c: len(c[1])):
+        width = perception.hand_opening(planner.hand)
+        spanned = [c for c in candidates if c.in_view and c.extent[1] <= width][:MAX_CANDIDATES]
+        for candidate, memory in sorted(((c, _memory_of(c.mask, failed)) for c in spanned), key=lambda c: len(c[1])):
             try:
                 planned = planner.plan(rgb, depth, intrinsics, memory=memory, target_px=deepest_pixel(candidate.mask))
                 return planned, None, time.perf_counter() - started

@@ -149,19 +149,20 @@ def draw_camera_panel(ax, snap, hand) -> None:
 
 
 def _outcome(record) -> str:
-    """A trial's outcome in a few words: held or why not; a clearing run's objects cleared and its end."""
+    """A trial's outcome in a few words: held or why not, how far it rose and moved, the fingers on it; a clearing
+    run's objects cleared, its end and its last attempt's cause."""
     if record.ended is not None:
-        return f"cleared {record.cleared}/{record.scene_objects}: {record.ended}"
-    return "held" if record.success else f"failed: {SHORT_CAUSES[record.cause]}"
+        last = "" if record.cause is None else f"; last: {SHORT_CAUSES[record.cause]}"
+        return f"cleared {record.cleared}/{record.scene_objects}: {record.ended}{last}"
+    outcome = "held" if record.success else f"failed: {SHORT_CAUSES[record.cause]}"
+    return (f"{outcome}; lifted {100 * record.lift:.1f} cm, moved {1000 * record.hold_drift:.0f} mm in the hand; "
+            f"touching: {', '.join(record.fingers_in_contact) or 'none'}")
 
 
 def draw_side_panel(ax, snap) -> None:
     """The scene at the end of the trial from the side (white where nothing is seen), with the outcome."""
     ax.imshow(np.where(snap.hit[..., None], snap.view, 255).astype(np.uint8))
-    record = snap.result.record
-    outcome = _outcome(record)
-    ax.set_title(f"{outcome}; lifted {100 * record.lift:.1f} cm, moved {1000 * record.hold_drift:.0f} mm in the "
-                 f"hand; touching: {', '.join(record.fingers_in_contact) or 'none'}", fontsize=8)
+    ax.set_title(_outcome(snap.result.record), fontsize=8)
 
 
 def _pixels(planned, points_xy) -> np.ndarray:
