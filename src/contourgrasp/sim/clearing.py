@@ -103,7 +103,7 @@ def run_clearing(object_spec, *, seed: int, planner, pool, scene_kind: str = "cl
         if not scene.present:
             ended = CLEARED
             break
-        rgb, depth = render(scene, sensor=sensor, seed=seed if attempt == 0 else noise_seed(seed, attempt, 0))
+        rgb, depth = render(scene, sensor=sensor, seed=seed if attempt == 0 else noise_seed(seed, attempt))
         planned, plan_error, spent = _plan_next(planner, rgb, depth, scene.camera.intrinsics, failed)
         plan_time += spent
         if planned is None:

@@ -240,9 +240,9 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
     the closed hand reports nothing held: its joints where they stop on nothing and no load on its wrist
     (:func:`~contourgrasp.sim.detect.hand_holds`), or it never closed (the descent stopped on a touch); not
     the simulator's truth -- and then the hand carries what it holds away, opens and leaves, the scene
-    settles as it is, a new picture is taken and the planner tries again, remembering the grasps that failed (its ``plan``
-    takes ``memory``: :class:`~contourgrasp.synthesis.GraspMemory`), until an attempt is told a
-    success or ``attempts`` were made. The record is the last attempt's, with every attempt's
+    settles as it is, a new picture is taken and the planner tries again, remembering the grasps that
+    failed (its ``plan`` takes ``memory``: :class:`~contourgrasp.synthesis.GraspMemory`), until an
+    attempt is told a success or ``attempts`` were made. The record is the last attempt's, with every attempt's
     true and told outcome (``outcomes``, ``detected``).
 
     Parameters
@@ -298,7 +298,7 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
                         hand=hand, design=design, timing=timing, camera=camera, workspace=workspace, robot=robot)
     memory, outcomes, detected, plan_time = GraspMemory(), [], [], 0.0
     for attempt in range(attempts):
-        rgb, depth = render(scene, sensor=sensor, seed=seed if attempt == 0 else noise_seed(seed, attempt, 0))
+        rgb, depth = render(scene, sensor=sensor, seed=seed if attempt == 0 else noise_seed(seed, attempt))
         fields, plan_error, planned, spent = _attempt(scene, planner, rgb, depth, camera, execution,
                                                       memory if attempts > 1 else None)
         plan_time += spent
@@ -341,9 +341,9 @@ def _move_closed(scene, start, joint: int, distance: float, duration: float) -> 
         scene.step()
 
 
-def noise_seed(seed: int, attempt: int, picture: int) -> int:
-    """The sensor noise's seed of a later picture of a trial: the attempt's, before (0) or after (1) it."""
-    return int(np.random.SeedSequence([seed, attempt, picture]).generate_state(1)[0])
+def noise_seed(seed: int, attempt: int) -> int:
+    """The sensor noise's seed of the picture before a later attempt of a trial."""
+    return int(np.random.SeedSequence([seed, attempt, 0]).generate_state(1)[0])
 
 
 def _attempt(scene, planner, rgb, depth, camera: Camera, execution: Execution, memory):
