@@ -67,3 +67,19 @@ def test_a_trial_of_a_planner_that_approaches_tilted_reproduces_for_its_snapshot
     assert result.record.pose is not None
     shot = snapshot(bench, result)
     assert shot.planned.approach == "tilted"
+
+
+def test_a_clearing_run_reproduces_for_its_snapshot():
+    """The mosaic reruns a clearing run through a recording planner: it has the planner's hand, so that after a
+    failure it asks about the same objects (those the hand spans)."""
+    from contourgrasp.sim.bench.run import _Recording, snapshot
+    from contourgrasp.sim.planners import make_planner
+
+    planner = make_planner("default", Bench(objects=thesis_objects(["can"])).hand)
+    assert _Recording(planner).hand is planner.hand
+
+    bench = Bench(objects=thesis_objects(["can", "case"]), planners=("default",), trials=1, scene_kind="clutter",
+                  protocol="clear")
+    result = run_bench(bench)[0]
+    assert result.record.pose is not None and result.record.ended is not None
+    assert snapshot(bench, result).planned is not None

@@ -160,11 +160,12 @@ def snapshot(bench: Bench, result: BenchTrial) -> Snapshot:
 
 class _Recording:
     """A trial's planner that keeps its last picture and plan in ``seen`` (``rgb``, ``planned``); its ``options``
-    are the planner's (they tell the trial whether its hand needs a wrist)."""
+    and ``hand`` are the planner's (they tell the trial whether its hand needs a wrist, and clearing how wide
+    an object the hand spans)."""
 
     def __init__(self, planner):
         self.planner, self.seen = planner, {}
-        self.options = getattr(planner, "options", None)
+        self.options, self.hand = getattr(planner, "options", None), planner.hand
 
     def plan(self, rgb, depth, intrinsics, **options) -> PlannedGrasp:
         self.seen["rgb"], self.seen["planned"] = rgb, self.planner.plan(rgb, depth, intrinsics, **options)
