@@ -266,7 +266,7 @@ def plan_frame(
         on_section = partial(_balanced_on_section, heights, hand, spec, asked[0], search_options, low, exclude)
     kinds = approach_order(scene_options.approaches, memory)
     if kinds != ["top"] and spec is None:
-        if not (scene_options.descent and hand.is_3d):
+        if not approaches_supported(hand, scene_options):
             raise PlannerError(f"approaches {scene_options.approaches!r} need descent=True and a 3-D hand "
                                f"(its file's chains): a side or tilted hand is checked against the scene in 3-D")
         raise NoFeasibleGrasp(f"approaches {scene_options.approaches!r} need a table plane: none was found")
@@ -284,6 +284,12 @@ def plan_frame(
     T_base_hand = None if T_base_camera is None else T_base_camera @ T_camera_hand
     return ImageGraspPlan(plan, seg, metric, intrinsics, T_camera_hand, T_camera_pregrasp, T_base_hand, filled,
                           heights, *scene, grasp_height=tip_height, view=view)
+
+
+def approaches_supported(hand: Hand, scene_options: SceneOptions) -> bool:
+    """Whether ``scene_options.approaches`` can be planned for ``hand``: top-down alone always; a side or tilted kind
+    needs ``descent`` and a 3-D hand (its file's chains), which check the hand against the scene along it."""
+    return scene_options.approaches == "top" or (scene_options.descent and hand.is_3d)
 
 
 def _plan_kinds(kinds, top_down, along) -> tuple[GraspPlan, ApproachView | None]:
@@ -360,8 +366,9 @@ def approach_order(approaches: str, memory: GraspMemory | None = None) -> list[s
 def _best_along(kind: str, *, heights: HeightMap, hand: Hand, scene_options: SceneOptions,
                 search_options: SearchOptions) -> tuple[GraspPlan | None, ApproachView | None]:
     """The lowest-cost plan along the approaches of ``kind`` (:func:`approach_set`), of those that balance the squeeze
-    where one does, and its view; (None, None) when none has a feasible pose. Each is planned on the target's cross-section at the grasp height asked
-    for in its view: the fingertips close there, and what stands in front of them is what they meet."""
+    where one does, and its view; (None, None) when none has a feasible pose. Each is planned on the target's
+    cross-section at the grasp height asked for in its view: the fingertips close there, and what stands in front
+    of them is what they meet."""
     best, best_view = None, None
     points = column_points(heights)
     for approach in approach_set(kind, heights):

@@ -49,7 +49,7 @@ from ..hand import Hand
 from ..io.hand_file import load_hand
 from ..io.plan_file import image_plan_to_dict
 from ..io.planner_file import Planner, load_planner
-from ..pipeline import PlanOptions, plan_frame
+from ..pipeline import PlanOptions, approaches_supported, plan_frame
 from ..synthesis import GraspMemory
 from ..threads import one_blas_thread
 from ..validation import with_options
@@ -125,7 +125,7 @@ def settings_from_parameters(values: dict) -> Settings:
         options = with_options(planner.options, given, what="parameters", error=InputError)
     except InputError as err:  # each one fits, not all of them together (a grid too large)
         raise InputError(f"parameters {', '.join(PARAMETER_OF.get(n, n) for n in given)} together: {err}") from None
-    _require(options.scene.approaches == "top" or (options.scene.descent and hand.is_3d), "approaches",
+    _require(approaches_supported(hand, options.scene), "approaches",
              "side and tilted approaches need a planner with descent and a 3-D hand", v)
     return Settings(hand, planner, v["pair_tolerance"], v["continuous"], options, target_pixel(v["target"]))
 
