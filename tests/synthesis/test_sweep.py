@@ -9,7 +9,7 @@ import pytest
 from contourgrasp import load_hand
 from contourgrasp.hand import chain_tip
 from contourgrasp.synthesis.descent import descent_clearance, height_base
-from contourgrasp.synthesis.sweep import closing_hits, link_first, obstacle_map
+from contourgrasp.synthesis.sweep import _near_obstacles, closing_hits, link_first, obstacle_map, obstacle_table
 
 from .test_descent import CELL, finger, middle_pose, scene
 
@@ -115,3 +115,25 @@ def test_the_obstacle_map_keeps_obstacles_only():
     only = obstacle_map(m)
     assert np.array_equal(only.heights, [[0.05, 0.0, 0.0, 0.0]])
     assert only.in_view.all() and not only.object.any() and np.isfinite(only.conservative()).all()
+
+
+def test_the_obstacle_table_counts_the_raised_cells_of_any_box():
+    rng = np.random.default_rng(0)
+    m = scene(lambda x, y: 0.0, shape=(9, 13))
+    m = replace(m, heights=np.where(rng.random((9, 13)) < 0.3, 0.02, 0.0))
+    table = obstacle_table(m)
+    raised = m.heights > 0
+    for r0, r1, c0, c1 in rng.integers(0, 14, (50, 4)):
+        r0, r1, c0, c1 = min(r0, 9), min(r1, 9), min(c0, 13), min(c1, 13)
+        if r1 < r0 or c1 < c0:
+            continue
+        assert table[r1, c1] - table[r0, c1] - table[r1, c0] + table[r0, c0] == raised[r0:r1, c0:c1].sum()
+
+
+def test_a_box_at_a_distance_is_not_near_and_one_across_the_sweep_is(hand):
+    i, heights, pose, base = box_in_path(hand, 0.02)
+    only = obstacle_map(heights)
+    reaches = np.full(len(hand.fingers), 0.2)
+    assert _near_obstacles(hand, only, obstacle_table(only), pose, reaches)[i]
+    far = replace(only, heights=np.roll(only.heights, only.heights.shape[1] // 2, axis=1))
+    assert not _near_obstacles(hand, far, obstacle_table(far), pose, reaches).any()

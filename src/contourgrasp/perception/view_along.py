@@ -200,13 +200,15 @@ def view_along(heights: HeightMap, approach: Approach, *, points=None) -> Approa
     n = np.asarray(heights.table_normal, dtype=float)
     n = n / np.linalg.norm(n)
     R = view_axes(approach, n)
-    centroid = pts[target].mean(axis=0)
-    origin = centroid + float(((pts[target] - centroid) @ R[:, 2]).max()) * R[:, 2]  # the target's back
+    target_pts = pts[target]
+    centroid = target_pts.mean(axis=0)
+    origin = centroid + float(((target_pts - centroid) @ R[:, 2]).max()) * R[:, 2]  # the target's back
     local = (pts - origin) @ R
-    near_enough = local[:, 2] >= local[target, 2].min() - VIEW_MARGIN  # the hand's way, over its reach
+    local_target = local[target]
+    near_enough = local[:, 2] >= local_target[:, 2].min() - VIEW_MARGIN  # the hand's way, over its reach
     cell = heights.cell * VIEW_CELL
-    low = local[target, :2].min(axis=0) - VIEW_MARGIN
-    shape = tuple((np.ceil((local[target, :2].max(axis=0) + VIEW_MARGIN - low) / cell).astype(int) + 1)[::-1])
+    low = local_target[:, :2].min(axis=0) - VIEW_MARGIN
+    shape = tuple((np.ceil((local_target[:, :2].max(axis=0) + VIEW_MARGIN - low) / cell).astype(int) + 1)[::-1])
     cells = (local[near_enough] - [*low, 0.0]) / [cell, cell, 1.0]
     near, near_target = _nearest(shape, cells), _nearest(shape, cells[target[near_enough]])
     centres = [low[k] + (np.arange(shape[1 - k]) + 0.5) * cell for k in (0, 1)]
@@ -229,8 +231,9 @@ def _nearest(shape, cells) -> np.ndarray:
     between columns seen slantwise) takes the least of theirs."""
     ij = np.floor(cells[:, :2]).astype(int)
     inside = (ij[:, 0] >= 0) & (ij[:, 0] < shape[1]) & (ij[:, 1] >= 0) & (ij[:, 1] < shape[0])
-    near = np.full(shape, np.inf)
-    np.minimum.at(near, (ij[inside, 1], ij[inside, 0]), cells[inside, 2])
+    near = np.full(shape[0] * shape[1], np.inf)
+    np.minimum.at(near, ij[inside, 1] * shape[1] + ij[inside, 0], cells[inside, 2])  # a flat index: numpy's fast path
+    near = near.reshape(shape)
     padded = np.pad(near, 1, constant_values=np.inf)
     pairs = ((padded[1:-1, :-2], padded[1:-1, 2:]), (padded[:-2, 1:-1], padded[2:, 1:-1]))
     gap = np.full(shape, np.inf)

@@ -85,7 +85,7 @@ from ..hand import Hand, chain_capsules, chain_tip, link_names
 from ..perception.height_map import HeightMap
 from ..tolerances import DESCENT_BATCH, DESCENT_MARGIN, MAX_DESCENT_POSES, MAX_HAND_SIZE
 from ._descent_kernels import map_clearances
-from .sweep import closing_hits, link_first, obstacle_centres, obstacle_map
+from .sweep import closing_hits, link_first, obstacle_map, obstacle_table
 
 #: Clearances within this of the margin pass (m): a pose raised to exactly the margin keeps it up to rounding.
 _ROUNDING = 1e-9
@@ -188,13 +188,13 @@ class Descent:
 
     @cached_property
     def closing_map(self) -> tuple[HeightMap, np.ndarray] | None:
-        """With ``closing`` and a map that has obstacle cells: their map alone and their centres
-        (:func:`~contourgrasp.synthesis.sweep.obstacle_map`, :func:`~contourgrasp.synthesis.sweep.obstacle_centres`),
+        """With ``closing`` and a map that has obstacle cells: their map alone and its summed-area table
+        (:func:`~contourgrasp.synthesis.sweep.obstacle_map`, :func:`~contourgrasp.synthesis.sweep.obstacle_table`),
         found once for every batch of candidates; else None."""
         if not self.closing or not self.heights.obstacles.any():
             return None
         only = obstacle_map(self.heights)
-        return only, obstacle_centres(only)
+        return only, obstacle_table(only)
 
 
 def body_names(hand: Hand) -> tuple[str, ...]:
@@ -372,9 +372,9 @@ def check_candidates(hand: Hand, descent: Descent, poses, order, lam=None,
             passed[rows[keep]] = ~_swept(link_first, hand, descent.heights, poses[rows[keep]], raised[keep],
                                          lam[rows[keep]], touching[rows[keep]])
         if descent.closing_map is not None and lam is not None:
-            obstacles, centres = descent.closing_map
+            obstacles, table = descent.closing_map
             keep = passed[rows]
-            passed[rows[keep]] = ~_swept(partial(closing_hits, centres=centres), hand, obstacles, poses[rows[keep]],
+            passed[rows[keep]] = ~_swept(partial(closing_hits, table=table), hand, obstacles, poses[rows[keep]],
                                          raised[keep], lam[rows[keep]], touching[rows[keep]])
         if passed[rows].any():
             break

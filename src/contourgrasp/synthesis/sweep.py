@@ -122,14 +122,15 @@ def obstacle_map(heights: HeightMap) -> HeightMap:
                    in_view=np.ones_like(heights.in_view))
 
 
-def obstacle_centres(obstacles: HeightMap) -> np.ndarray:
-    """(k, 2) float: the planning-frame (x, y) of the centres of ``obstacles``'s raised cells (an :func:`obstacle_map`)."""
-    rows, cols = np.nonzero(obstacles.heights > 0.0)
-    return np.asarray(obstacles.origin, dtype=float) + (np.c_[cols, rows] + 0.5) * obstacles.cell
+def obstacle_table(obstacles: HeightMap) -> np.ndarray:
+    """(rows + 1, cols + 1) int: the summed-area table of ``obstacles``'s raised cells (an :func:`obstacle_map`):
+    entry (i, j) counts those in rows below i and columns below j, so a box's count is four look-ups."""
+    raised = (np.asarray(obstacles.heights) > 0.0).astype(np.int64)
+    return np.pad(raised.cumsum(axis=0).cumsum(axis=1), ((1, 0), (1, 0)))
 
 
 def closing_hits(hand: Hand, obstacles: HeightMap, pose, base: float, lam, touching, *,
-                 centres=None) -> np.ndarray:
+                 table=None) -> np.ndarray:
     """(f,) bool: per finger, whether its chain runs into an obstacle while it closes (module docstring).
 
     Parameters
@@ -144,35 +145,40 @@ def closing_hits(hand: Hand, obstacles: HeightMap, pose, base: float, lam, touch
         Each finger's planned travel to its grasp point, m (ignored where it misses).
     touching : (f,) bool
         A touching finger stops a radius before its grasp point; the others close to their end.
-    centres : (k, 2) float, optional
-        :func:`obstacle_centres` of ``obstacles``, when it is checked for many poses.
+    table : (rows + 1, cols + 1) int, optional
+        :func:`obstacle_table` of ``obstacles``, when it is checked for many poses.
     """
     reaches = [float(travelled) - chain.radius if touches else float(_travel(chain)[1][-1])
                for chain, travelled, touches in zip(hand.chains, lam, touching)]
-    centres = obstacle_centres(obstacles) if centres is None else centres
-    near = _near_obstacles(hand, obstacles.cell, centres, pose, reaches)
+    table = obstacle_table(obstacles) if table is None else table
+    near = _near_obstacles(hand, obstacles, table, pose, reaches)
     return _below_map(hand, obstacles, pose, base, np.where(near, reaches, np.nan))
 
 
-def _near_obstacles(hand: Hand, cell: float, centres, pose, reaches) -> np.ndarray:
-    """(f,) bool: fingers whose whole closing sweep's box (grown by their radius and a cell) holds an obstacle cell.
+def _near_obstacles(hand: Hand, obstacles: HeightMap, table, pose, reaches) -> np.ndarray:
+    """(f,) bool: fingers whose whole closing sweep's box (grown by their radius and a cell) holds the centre of an
+    obstacle cell (``table``: :func:`obstacle_table`).
 
     Most poses of a scene with a distant neighbour sweep nowhere near it; the exact check is for those that do.
     The box is the whole sweep's (:func:`_sweep_points`), computed once per finger: a finger that stops
     earlier sweeps inside it, so no finger that could hit is left out.
     """
     near = np.zeros(len(hand.chains), dtype=bool)
-    if not len(centres):
-        return near
     c, s = np.cos(pose[2]), np.sin(pose[2])
     turn = np.array([[c, s], [-s, c]])
+    last = np.array(table.shape[::-1]) - 2  # the last column and row
     for f, (chain, reach) in enumerate(zip(hand.chains, reaches)):
         if not reach > 0:
             continue
         placed = np.asarray(pose[:2], dtype=float) + _sweep_points(chain) @ turn
-        grow = chain.radius + cell
-        low, high = placed.min(axis=0) - grow, placed.max(axis=0) + grow
-        near[f] = bool(np.any(np.all((centres >= low) & (centres <= high), axis=1)))
+        grow = chain.radius + obstacles.cell
+        # the cells whose centres origin + (index + 1/2) cell lie in the box, clipped to the map
+        first = np.maximum(np.ceil((placed.min(axis=0) - grow - obstacles.origin) / obstacles.cell - 0.5), 0)
+        final = np.minimum(np.floor((placed.max(axis=0) + grow - obstacles.origin) / obstacles.cell - 0.5), last)
+        if (final < first).any():
+            continue
+        (c0, r0), (c1, r1) = first.astype(int), final.astype(int) + 1
+        near[f] = table[r1, c1] - table[r0, c1] - table[r1, c0] + table[r0, c0] > 0
     return near
 
 
