@@ -82,7 +82,8 @@ def test_a_cylinder_is_as_wide_as_its_diameter_from_every_side(azimuth):
 
 
 def test_columns_fill_the_target_down_to_the_table_and_leave_the_table_out(box):
-    points, target = column_points(box)
+    columns = column_points(box)
+    points, target = columns.points, columns.target
     assert target.all()  # one object on a bare table: every column is the target's
     heights = box.height_of(points)
     assert heights.min() == pytest.approx(0.0, abs=1e-9) and heights.max() == pytest.approx(0.08, abs=2e-3)
