@@ -568,6 +568,42 @@ def test_a_tilted_plan_carries_its_approach_into_the_pose_the_json_and_the_figur
     assert "R_camera_view" not in image_plan_to_dict(top)["approach"]
 
 
+def test_a_later_kind_is_asked_for_a_balanced_plan_alone_once_an_earlier_kind_has_one():
+    from types import SimpleNamespace
+
+    unbalanced, balanced = SimpleNamespace(balanced=False), SimpleNamespace(balanced=True)
+    asked = []
+
+    def along(kind, balanced_only):
+        asked.append((kind, balanced_only))
+        return (balanced if kind == "side" else None), kind
+
+    assert pipeline._plan_kinds(["top", "tilted", "side"], lambda: unbalanced, along) == (balanced, "side")
+    assert asked == [("tilted", True), ("side", True)]
+    asked.clear()
+
+    def no_top():
+        raise cg.NoFeasibleGrasp("none")
+
+    assert pipeline._plan_kinds(["top", "tilted", "side"], no_top, along) == (balanced, "side")
+    assert asked == [("tilted", False), ("side", False)]
+
+
+def test_the_balanced_plan_along_a_kind_is_the_same_asked_for_alone(standing_can_frame):
+    rgb, depth, K = standing_can_frame
+    hand = cg.load_hand("five-finger-linear")
+    result = cg.plan_grasp(rgb, depth, K, hand, descent=True, grasp_height="auto", yaw_step=0.1, approaches="tilted")
+    options = cg.load_planner("default").options
+    search_options = replace(options.search, grid=replace(options.search.grid, yaw_step=0.1))
+    common = {"heights": result.height_map, "hand": hand, "scene_options": options.scene,
+              "search_options": search_options}
+    preferred, view = pipeline._best_along("tilted", **common)
+    alone, alone_view = pipeline._best_along("tilted", balanced_only=True, **common)
+    assert preferred.balanced and alone.cost.total == preferred.cost.total
+    np.testing.assert_array_equal(alone.pose, preferred.pose)
+    assert alone_view.approach == view.approach
+
+
 @pytest.mark.parametrize("options, message", [
     ({"grasp_height": "high"}, "grasp_height"), ({"grasp_height": -1.0}, "grasp_height"),
     ({"descent": "yes"}, "descent"), ({"slice_contour": 1}, "slice_contour"), ({"slice_contour": "always"}, "slice_contour"),

@@ -296,8 +296,9 @@ def _plan_kinds(kinds, top_down, along) -> tuple[GraspPlan, ApproachView | None]
     """The plan of the first kind in ``kinds`` with a feasible pose, or of the first after it that balances the
     squeeze where it does not (:func:`approach_order`), and its view (None: top-down).
 
-    ``top_down()`` plans top-down (raising NoFeasibleGrasp), ``along(kind)`` a side or tilted kind ((None, None):
-    none). Raises the top-down reason when top-down alone was asked for and failed, else NoFeasibleGrasp."""
+    ``top_down()`` plans top-down (raising NoFeasibleGrasp), ``along(kind, balanced_only)`` a side or tilted kind
+    ((None, None): none; ``balanced_only`` once an earlier kind has a plan, which only a balanced one replaces).
+    Raises the top-down reason when top-down alone was asked for and failed, else NoFeasibleGrasp."""
     plan, view, top_down_error = None, None, None
     for kind in kinds:
         found, seen_along = None, None
@@ -307,7 +308,7 @@ def _plan_kinds(kinds, top_down, along) -> tuple[GraspPlan, ApproachView | None]
             except NoFeasibleGrasp as err:
                 top_down_error = err
         else:
-            found, seen_along = along(kind)
+            found, seen_along = along(kind, balanced_only=plan is not None)
         if found is not None and (plan is None or found.balanced):
             plan, view = found, seen_along
         if plan is not None and plan.balanced:
@@ -363,12 +364,12 @@ def approach_order(approaches: str, memory: GraspMemory | None = None) -> list[s
     return sorted(kinds, key=lambda kind: failed.get(kind, 0))
 
 
-def _best_along(kind: str, *, heights: HeightMap, hand: Hand, scene_options: SceneOptions,
-                search_options: SearchOptions) -> tuple[GraspPlan | None, ApproachView | None]:
+def _best_along(kind: str, *, balanced_only: bool = False, heights: HeightMap, hand: Hand,
+                scene_options: SceneOptions, search_options: SearchOptions) -> tuple[GraspPlan | None, ApproachView | None]:
     """The lowest-cost plan along the approaches of ``kind`` (:func:`approach_set`), of those that balance the squeeze
-    where one does, and its view; (None, None) when none has a feasible pose. Each is planned on the target's
-    cross-section at the grasp height asked for in its view: the fingertips close there, and what stands in front
-    of them is what they meet."""
+    where one does (``balanced_only``: of those alone, so no approach's search goes on without the balance), and its
+    view; (None, None) when none has a feasible pose. Each is planned on the target's cross-section at the grasp
+    height asked for in its view: the fingertips close there, and what stands in front of them is what they meet."""
     best, best_view = None, None
     points = column_points(heights)
     for approach in approach_set(kind, heights):
@@ -382,7 +383,7 @@ def _best_along(kind: str, *, heights: HeightMap, hand: Hand, scene_options: Sce
             continue
         spec = Descent(view.heights, *asked, sweep=scene_options.closing_sweep, closing=scene_options.closing_obstacles)
         try:
-            plan = search(section, hand, search_options, descent=spec)
+            plan = search(section, hand, search_options, descent=spec, balance_required=balanced_only)
         except NoFeasibleGrasp:
             continue
         if best is None or (not plan.balanced, plan.cost.total) < (not best.balanced, best.cost.total):
