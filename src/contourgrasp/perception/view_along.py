@@ -39,6 +39,7 @@ import numpy as np
 from .. import validation
 from ..errors import PerceptionError
 from ..tolerances import MIN_HEIGHT, VIEW_CELL, VIEW_MARGIN
+from ._view_kernels import least_depths, target_extent
 from .height_map import HeightMap
 
 #: The kinds of approach (:attr:`Approach.kind`): top-down, horizontal, tilted.
@@ -156,14 +157,9 @@ class Columns:
     target: np.ndarray
 
     @cached_property
-    def target_points(self) -> np.ndarray:
-        """(t, 3) float: the target's points."""
-        return self.points[self.target]
-
-    @cached_property
     def centroid(self) -> np.ndarray:
         """(3,) float: the mean of the target's points, the same along every approach."""
-        return self.target_points.mean(axis=0)
+        return self.points[self.target].mean(axis=0)
 
 
 def column_points(heights: HeightMap) -> Columns:
@@ -221,19 +217,13 @@ def view_along(heights: HeightMap, approach: Approach, *, points=None) -> Approa
     n = n / np.linalg.norm(n)
     R = view_axes(approach, n)
     centroid = columns.centroid
-    origin = centroid + float(((columns.target_points - centroid) @ R[:, 2]).max()) * R[:, 2]  # the target's back
-    local = (columns.points - origin) @ R
-    local_target = local[columns.target]
-    # what else is on the hand's way, over its reach (every target point is)
-    others = ~columns.target & (local[:, 2] >= local_target[:, 2].min() - VIEW_MARGIN)
+    origin = centroid + target_extent(columns.points, columns.target, centroid, R)[5] * R[:, 2]  # the target's back
+    x0, x1, y0, y1, z0, _ = target_extent(columns.points, columns.target, origin, R)
     cell = heights.cell * VIEW_CELL
-    # one column at a time: numpy reduces a contiguous column ten times faster than an (n, 2) block along axis 0
-    low = np.array([local_target[:, 0].min(), local_target[:, 1].min()]) - VIEW_MARGIN
-    high = np.array([local_target[:, 0].max(), local_target[:, 1].max()]) + VIEW_MARGIN
+    low, high = np.array([x0, y0]) - VIEW_MARGIN, np.array([x1, y1]) + VIEW_MARGIN
     shape = tuple((np.ceil((high - low) / cell).astype(int) + 1)[::-1])
-    scale = [cell, cell, 1.0]
-    least_target = _least_depths(shape, (local_target - [*low, 0.0]) / scale)
-    least = np.minimum(least_target, _least_depths(shape, (local[others] - [*low, 0.0]) / scale))
+    least, least_target = least_depths(columns.points, columns.target, origin, R, low, cell, *shape,
+                                       z0 - VIEW_MARGIN)  # what stands on the hand's way, over its reach
     near, near_target = _fill_gaps(least), _fill_gaps(least_target)
     centres = [low[k] + (np.arange(shape[1 - k]) + 0.5) * cell for k in (0, 1)]
     table = _table_depth(R, origin, n, float(heights.table_offset), *centres)
@@ -249,18 +239,8 @@ def view_along(heights: HeightMap, approach: Approach, *, points=None) -> Approa
     return ApproachView(approach, view, _outline(object_cells, low, cell), R, origin)
 
 
-def _least_depths(shape, cells) -> np.ndarray:
-    """(ny, nx) float: the least depth per cell of points (p, 3) given as (column, row, depth) (+inf where none;
-    off the grid ignored)."""
-    ij = np.floor(cells[:, :2]).astype(int)
-    inside = (ij[:, 0] >= 0) & (ij[:, 0] < shape[1]) & (ij[:, 1] >= 0) & (ij[:, 1] < shape[0])
-    least = np.full(shape[0] * shape[1], np.inf)
-    np.minimum.at(least, ij[inside, 1] * shape[1] + ij[inside, 0], cells[inside, 2])  # a flat index: numpy's fast path
-    return least.reshape(shape)
-
-
 def _fill_gaps(least) -> np.ndarray:
-    """``least`` (:func:`_least_depths`) where an empty cell between two filled ones (left and right, or above and
+    """``least`` (a map of :func:`~contourgrasp.perception._view_kernels.least_depths`) where an empty cell between two filled ones (left and right, or above and
     below: a gap between columns seen slantwise) takes the least of theirs."""
     padded = np.pad(least, 1, constant_values=np.inf)
     pairs = ((padded[1:-1, :-2], padded[1:-1, 2:]), (padded[:-2, 1:-1], padded[2:, 1:-1]))

@@ -52,12 +52,16 @@ def _travel(chain: FingerChain | SampledChain) -> tuple[np.ndarray, np.ndarray]:
     return s, np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(tips, axis=0), axis=1))]
 
 
+@lru_cache(maxsize=256)
 def _swept_capsules(chain: FingerChain | SampledChain, reach: float) -> np.ndarray:
     """(k m, 2, 3) float: the k links' capsules (a planar chain's proximal and distal) at ``SWEEP_SAMPLES`` closing
-    progresses whose tips have travelled evenly from 0 to ``reach`` (m) in the palm plane."""
+    progresses whose tips have travelled evenly from 0 to ``reach`` (m) in the palm plane. Cached: a finger that
+    closes on air sweeps its whole travel at every pose checked (read-only)."""
     s_grid, distance = _travel(chain)
     s = np.interp(np.linspace(0.0, reach, tol.SWEEP_SAMPLES), distance, s_grid)
-    return chain_capsules(chain, s)[:, 1:].reshape(-1, 2, 3)
+    capsules = chain_capsules(chain, s)[:, 1:].reshape(-1, 2, 3)
+    capsules.flags.writeable = False
+    return capsules
 
 
 def _below_map(hand: Hand, heights: HeightMap, pose, base: float, reaches) -> np.ndarray:
