@@ -568,6 +568,21 @@ def test_a_tilted_plan_carries_its_approach_into_the_pose_the_json_and_the_figur
     assert "R_camera_view" not in image_plan_to_dict(top)["approach"]
 
 
+def test_after_a_tilted_grasp_failed_the_next_plan_comes_from_another_direction(standing_can_frame):
+    from contourgrasp.synthesis import GraspMemory
+
+    rgb, depth, K = standing_can_frame
+    options = {"descent": True, "grasp_height": "auto", "yaw_step": 0.1, "approaches": "tilted"}
+    hand = cg.load_hand("five-finger-linear")
+    first = cg.plan_grasp(rgb, depth, K, hand, **options)
+    memory = GraspMemory().with_failure(first.metric.contour_xy, first.plan.pose, approach=first.approach)
+    again = cg.plan_grasp(rgb, depth, K, hand, memory=memory, **options)
+    assert again.approach.kind == "tilted"
+    apart = abs((again.approach.azimuth - first.approach.azimuth + np.pi / 2) % np.pi - np.pi / 2)
+    assert apart > tol.MEMORY_TURN  # neither the failed direction nor its opposite
+    assert cg.plan_grasp(rgb, depth, K, hand, **options).approach == first.approach  # without the memory: the same
+
+
 def test_a_later_kind_is_asked_for_a_balanced_plan_alone_once_an_earlier_kind_has_one():
     from types import SimpleNamespace
 

@@ -208,10 +208,10 @@ def plan_frame(
         scaled.
     memory : GraspMemory, optional
         The grasps of this object that failed (:class:`~contourgrasp.synthesis.memory.GraspMemory`): no
-        pose near one, in the object's frame as it is seen now, is planned, and the approach kinds that
-        failed fewer times are tried first (:func:`approach_order`). After a failure, keep
-        ``memory.with_failure(result.metric.contour_xy, result.plan.pose, approach=result.approach.kind)``
-        for the next plan.
+        pose near one, in the object's frame as it is seen now, is planned, nor a side or tilted direction near
+        one that failed, and the approach kinds that failed fewer times are tried first (:func:`approach_order`).
+        After a failure, keep ``memory.with_failure(result.metric.contour_xy, result.plan.pose,
+        approach=result.approach)`` for the next plan.
 
     Notes
     -----
@@ -261,6 +261,7 @@ def plan_frame(
     slicing = hand.slice_contour if scene_options.slice_contour == "hand" else scene_options.slice_contour
     section = perception.cross_section(heights, asked[0]) if slicing is True and asked is not None else None
     exclude = None if not memory else partial(memory.excluded, metric.contour_xy)
+    avoid = None if not memory else partial(memory.avoids, metric.contour_xy)
     on_section = None
     if slicing == "unbalanced" and asked is not None:
         on_section = partial(_balanced_on_section, heights, hand, spec, asked[0], search_options, low, exclude)
@@ -272,7 +273,7 @@ def plan_frame(
         raise NoFeasibleGrasp(f"approaches {scene_options.approaches!r} need a table plane: none was found")
     top_down = partial(search, metric.contour_xy if section is None else section, hand, search_options, descent=spec,
                        balanced_alternative=on_section, low_object=low, exclude=exclude)
-    plan, view = _plan_kinds(kinds, top_down, partial(_best_along, heights=heights, hand=hand,
+    plan, view = _plan_kinds(kinds, top_down, partial(_best_along, heights=heights, hand=hand, avoid=avoid,
                                                       scene_options=scene_options, search_options=search_options))
     tip_height = None if asked is None else asked[0] if plan.descent is None else float(plan.descent.tip_height[0])
     frame = plan_metric(metric, view)
@@ -365,14 +366,18 @@ def approach_order(approaches: str, memory: GraspMemory | None = None) -> list[s
 
 
 def _best_along(kind: str, *, balanced_only: bool = False, heights: HeightMap, hand: Hand,
-                scene_options: SceneOptions, search_options: SearchOptions) -> tuple[GraspPlan | None, ApproachView | None]:
-    """The lowest-cost plan along the approaches of ``kind`` (:func:`approach_set`), of those that balance the squeeze
-    where one does (``balanced_only``: of those alone, so no approach's search goes on without the balance), and its
-    view; (None, None) when none has a feasible pose. Each is planned on the target's cross-section at the grasp
-    height asked for in its view: the fingertips close there, and what stands in front of them is what they meet."""
+                scene_options: SceneOptions, search_options: SearchOptions,
+                avoid=None) -> tuple[GraspPlan | None, ApproachView | None]:
+    """The lowest-cost plan along the approaches of ``kind`` (:func:`approach_set`) that ``avoid`` (Approach -> bool:
+    a grasp failed along it) does not refuse, of those that balance the squeeze where one does (``balanced_only``: of
+    those alone, so no approach's search goes on without the balance), and its view; (None, None) when none has a
+    feasible pose. Each is planned on the target's cross-section at the grasp height asked for in its view: the
+    fingertips close there, and what stands in front of them is what they meet."""
     best, best_view = None, None
     points = column_points(heights)
     for approach in approach_set(kind, heights):
+        if avoid is not None and avoid(approach):
+            continue
         try:
             view = view_along(heights, approach, points=points)
         except PerceptionError:  # the target hidden along it

@@ -205,7 +205,7 @@ def test_a_standing_can_planned_from_the_side_or_tilted_is_lifted(approaches, el
     scene = build_scene(soda_can(standing=True), seed=2, hand=hand, design=HandDesign(wrist=True))
     rgb, depth = render(scene, sensor="basic", seed=2)
     planned = planner.plan(rgb, depth, scene.camera.intrinsics)
-    assert planned.approach == approaches
+    assert planned.approach.kind == approaches
     approach_world = R_WORLD_CAMERA @ planned.T_camera_hand[:3, 2]
     assert math.degrees(math.asin(-approach_world[2])) == pytest.approx(elevation_deg, abs=1.0)
     outcome = execute_grasp(scene, planned.T_camera_hand, planned.approach_depth, grasp_height=planned.grasp_height)

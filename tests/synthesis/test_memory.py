@@ -97,6 +97,21 @@ def test_the_next_plan_of_the_bundled_frame_avoids_the_failed_one():
         cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, yaw_step=0.1, memory=[first.plan.pose])
 
 
+def test_a_failed_direction_is_avoided_of_its_kind_both_ways_round_the_axis_and_turns_with_the_object():
+    from contourgrasp.perception import Approach
+
+    bar = np.array([[0.0, 0.0], [0.08, 0.0], [0.08, 0.02], [0.0, 0.02]])  # its axis along x
+    failed = Approach(np.pi / 4, 0.3)
+    memory = GraspMemory().with_failure(bar, (0.0, 0.0, 0.0), approach=failed)
+    assert memory.kinds == ("tilted",) and not memory.failures
+    avoided = [memory.avoids(bar, Approach(np.pi / 4, a)) for a in (0.3, 0.5, 0.3 + np.pi, 0.3 + np.pi / 2, 0.7)]
+    assert avoided == [True, True, True, False, False]  # MEMORY_TURN is 20 deg
+    assert not memory.avoids(bar, Approach(0.0, 0.3))  # a side approach along the same azimuth: another kind
+    turned = bar @ np.array([[0.0, 1.0], [-1.0, 0.0]])  # the bar turned a quarter round: its axis along y
+    assert memory.avoids(turned, Approach(np.pi / 4, 0.3 + np.pi / 2))
+    assert not memory.avoids(turned, Approach(np.pi / 4, 0.3))
+
+
 def test_a_failure_from_the_side_is_kept_as_its_kind_only():
     square = np.array([[0.0, 0.0], [0.04, 0.0], [0.04, 0.02], [0.0, 0.02]])
     memory = GraspMemory().with_failure(square, (0.02, 0.05, 0.0)).with_failure(square, (0.0, 0.0, 1.0),

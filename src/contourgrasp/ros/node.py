@@ -271,7 +271,7 @@ class ContourGraspNode(Node):
             response.success, response.message = True, "the grasp succeeded: the memory of failed grasps is cleared"
         else:
             self.memory = self.memory.with_failure(self.last.metric.contour_xy, self.last.plan.pose,
-                                                   approach=self.last.approach.kind)
+                                                   approach=self.last.approach)
             self.last = None  # reported once
             response.success, response.message = True, (
                 f"the grasp failed: remembered; the next plans avoid the {len(self.memory)} failed grasp(s)")

@@ -125,9 +125,9 @@ class PlannedGrasp:
     view: perception.ApproachView | None = None
 
     @property
-    def approach(self) -> str:
-        """The plan's kind of approach: "top", "side" or "tilted" (:attr:`contourgrasp.perception.Approach.kind`)."""
-        return "top" if self.view is None else self.view.approach.kind
+    def approach(self) -> perception.Approach:
+        """The plan's approach (top-down: :data:`contourgrasp.pipeline.TOP_DOWN`)."""
+        return pipeline.TOP_DOWN if self.view is None else self.view.approach
 
 
 @dataclass(frozen=True)

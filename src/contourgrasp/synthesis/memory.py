@@ -12,13 +12,16 @@ ball) has no axis that turns with it, and its frame keeps the planning frame's o
 :func:`~contourgrasp.synthesis.search` applies to its screened poses (``exclude=``).
 
 A grasp approached from the side or tilted (:mod:`contourgrasp.perception.view_along`) is kept as its
-kind of approach only: the next plan tries the kinds that failed fewer times first
-(:func:`contourgrasp.pipeline.approach_order`). Its pose is not kept: the approach frame is the object's
-as seen along that approach, and the next plan may see it along another.
+kind of approach and its direction: the next plan tries the kinds that failed fewer times first
+(:func:`contourgrasp.pipeline.approach_order`), and of a kind, no direction within
+``tolerances.MEMORY_TURN`` of one that failed, in the object's frame (its azimuth relative to the principal
+axis, mapped both ways round it as a pose is). Its pose is not kept: the approach frame is the object's as
+seen along that approach, so the same direction seen again plans the same grasp.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import cv2
@@ -26,13 +29,15 @@ import numpy as np
 
 from .. import validation
 from ..errors import PlannerError
-from ..perception.view_along import APPROACH_KINDS
+from ..perception.view_along import APPROACH_KINDS, Approach
 from ..tolerances import MAX_MEMORY_FAILURES, MEMORY_REACH, MEMORY_ROUND, MEMORY_TURN
 
 
 @dataclass(frozen=True)
 class GraspMemory:
-    """The failed grasps of one object, each a pose (x, y, yaw) in the object's frame (module docstring).
+    """The failed grasps of one object in the object's frame (module docstring): a top-down one as its pose
+    (x, y, yaw) in ``failures``, a side or tilted one as its kind and azimuth (rad; NaN: not known) in
+    ``directions``; ``kinds`` every failure's kind, oldest first.
 
     Immutable: :meth:`with_failure` returns a new memory. At most ``tolerances.MAX_MEMORY_FAILURES``
     are kept, the oldest dropped first.
@@ -48,21 +53,28 @@ class GraspMemory:
 
     failures: tuple[tuple[float, float, float], ...] = ()
     kinds: tuple[str, ...] = ()
+    directions: tuple[tuple[str, float], ...] = ()
 
     def __len__(self) -> int:
         return len(self.kinds)
 
-    def with_failure(self, contour_xy, pose, *, approach: str = "top") -> GraspMemory:
+    def with_failure(self, contour_xy, pose, *, approach: str | Approach = "top") -> GraspMemory:
         """This memory and the failed grasp ``pose`` (x, y, yaw) planned on the outline ``contour_xy`` ((n, 2) m),
-        approached as ``approach`` says ("top", "side" or "tilted"; of the latter two only the kind is kept)."""
+        approached as ``approach`` says: the plan's :class:`~contourgrasp.perception.Approach` (a side or tilted one's
+        direction is kept), or its kind, "top", "side" or "tilted" (of the latter two only the kind is kept)."""
         x, y, yaw = validation.finite_array("pose", pose, (3,), error=PlannerError)
-        approach = validation.choice("approach", approach, APPROACH_KINDS, error=PlannerError)
-        kinds, failures = (*self.kinds, approach)[-MAX_MEMORY_FAILURES:], self.failures
-        if approach == "top":
-            centre, angle = object_frame(contour_xy)
+        kind = approach.kind if isinstance(approach, Approach) else validation.choice(
+            "approach", approach, APPROACH_KINDS, error=PlannerError)
+        kinds, failures, directions = (*self.kinds, kind)[-MAX_MEMORY_FAILURES:], self.failures, self.directions
+        centre, angle = object_frame(contour_xy)
+        if kind == "top":
             local = _rotation(-angle) @ (np.array([x, y]) - centre)
             failures = (*failures, (float(local[0]), float(local[1]), float(_wrapped(yaw - angle))))
-        return GraspMemory(failures[len(failures) - kinds.count("top"):], kinds)  # the top-down ones still kept
+        else:
+            azimuth = float(_wrapped(approach.azimuth - angle)) if isinstance(approach, Approach) else math.nan
+            directions = (*directions, (kind, azimuth))
+        others = len(kinds) - kinds.count("top")  # the failures of each sort still kept
+        return GraspMemory(failures[len(failures) - kinds.count("top"):], kinds, directions[len(directions) - others:])
 
     def failures_by_kind(self) -> dict[str, int]:
         """How many grasps failed per kind of approach."""
@@ -83,6 +95,17 @@ class GraspMemory:
             near &= np.abs(_wrapped(poses[:, None, 2] - yaw[None])) <= MEMORY_TURN
             out |= near.any(axis=1)
         return out
+
+
+    def avoids(self, contour_xy, approach: Approach) -> bool:
+        """Whether a grasp failed along ``approach`` (side or tilted) or within ``MEMORY_TURN`` of it, the failed
+        directions mapped onto the outline ``contour_xy`` ((m, 2) m) as it is seen now (module docstring)."""
+        failed = [azimuth for kind, azimuth in self.directions if kind == approach.kind and math.isfinite(azimuth)]
+        if not failed:
+            return False
+        _, angle = object_frame(contour_xy)
+        turns = np.add.outer(np.asarray(failed), [angle, angle + np.pi])  # the axis has no sign
+        return bool((np.abs(_wrapped(approach.azimuth - turns)) <= MEMORY_TURN).any())
 
 
 def object_frame(contour_xy) -> tuple[np.ndarray, float]:

@@ -66,7 +66,7 @@ def test_a_trial_of_a_planner_that_approaches_tilted_reproduces_for_its_snapshot
     result = run_bench(bench)[0]
     assert result.record.pose is not None
     shot = snapshot(bench, result)
-    assert shot.planned.approach == "tilted"
+    assert shot.planned.approach.kind == "tilted"
 
 
 def test_a_clearing_run_reproduces_for_its_snapshot():
