@@ -96,7 +96,6 @@ class GraspMemory:
             out |= near.any(axis=1)
         return out
 
-
     def avoids(self, contour_xy, approach: Approach) -> bool:
         """Whether a grasp failed along ``approach`` (side or tilted) or within ``MEMORY_TURN`` of it, the failed
         directions mapped onto the outline ``contour_xy`` ((m, 2) m) as it is seen now (module docstring)."""

@@ -163,8 +163,8 @@ def _cause_legend(bench: Bench) -> str:
 
 def _success_text(bench: Bench) -> str:
     if bench.protocol == "clear":
-        return ("Success: every object of the scene cleared (taken off the table by a grasp a new picture told "
-                "lifted); the cause is the last attempt's.")
+        return ("Success: every object of the scene cleared (taken off the table by a grasp the hand told held); "
+                "the cause is the last attempt's.")
     text = "Success: lifted at least 0.10 m and moved less than 0.02 m in the hand during the 2 s hold."
     if bench.scene_kind == "single":
         return text
@@ -407,13 +407,13 @@ def family_table(bench: Bench, results) -> list[str]:
 
 def attempts_section(bench: Bench, results) -> list[str]:
     """With several attempts per trial: per planner and group, success at the first attempt and within the
-    bench's attempts and the attempts made, and how the pictures told each attempt's outcome; [] with one."""
+    bench's attempts and the attempts made, and how the hand told each attempt's outcome; [] with one."""
     if bench.attempts == 1:
         return []
     lines = ["", f"## Attempts (at most {bench.attempts})", "",
              "Per trial: success at the first attempt, success within the attempts (the last attempt's: the "
-             "trial stops when a picture says the object was lifted), and the attempts made. Then every attempt "
-             "made, its outcome as the picture after it told it (detected) against the simulator's (true).", ""]
+             "trial stops when the hand tells it holds the object), and the attempts made. Then every attempt "
+             "made, its outcome as the hand told it (detected) against the simulator's (true).", ""]
     lines += _header("planner", ["group", "first attempt", f"within {bench.attempts}", "attempts per trial"], left=1)
     groups = _groups(bench) if bench.splits else [("all", tuple(o.name for o in bench.objects))]
     for planner in bench.planners:
@@ -427,7 +427,7 @@ def attempts_section(bench: Bench, results) -> list[str]:
 
 
 def detection_table(results) -> list[str]:
-    """Every attempt made, its outcome as the picture after it told it (detected) against the simulator's (true)."""
+    """Every attempt made, its outcome as the hand told it (detected) against the simulator's (true)."""
     pairs = [(d, t) for r in results for d, t in zip(r.record.detected, r.record.outcomes)]
     told = {(d, t): sum(1 for p in pairs if p == (d, t)) for d in (True, False) for t in (True, False)}
     return ["", *_header("detected \\ true", ["succeeded", "failed"]),
@@ -439,7 +439,7 @@ def detection_table(results) -> list[str]:
 
 def clearing_section(bench: Bench, results) -> list[str]:
     """With the ``clear`` protocol: per planner and group, success per attempt, objects cleared, attempts per
-    object and tables cleared; how the runs ended; how the pictures told each attempt. [] otherwise."""
+    object and tables cleared; how the runs ended; how the hand told each attempt. [] otherwise."""
     if bench.protocol != "clear":
         return []
     lines = ["", "## Clearing the table", "",
