@@ -35,7 +35,7 @@ from .perception import Approach, ApproachView, HeightMap, Intrinsics, MetricCon
 from .perception.camera import check_intrinsics
 from .perception.options import PerceptionOptions
 from .perception.view_along import column_points
-from .synthesis import Descent, GraspMemory, GraspPlan, search
+from .synthesis import Descent, GraspMemory, GraspPlan, SceneMemory, search
 from .synthesis.grasp_height import grasp_height as choose_grasp_height
 from .synthesis.options import SceneOptions, SearchOptions
 from .tolerances import HOMOGENEOUS_ROW, MAX_STANDOFF, ROTATION_TOLERANCE
@@ -156,6 +156,17 @@ class ImageGraspPlan:
         """The frame ``plan`` is in (:func:`plan_metric`): ``metric``'s, or the approach frame of :attr:`view`."""
         return plan_metric(self.metric, self.view)
 
+    @property
+    def seen(self) -> np.ndarray:
+        """(H, W) bool: the depth image's pixels that see the planned object (the target candidate's; else the
+        segmentation's mask), what a :class:`~contourgrasp.synthesis.SceneMemory` finds the object by."""
+        return _seen(self.segmentation, self.target)
+
+
+def _seen(segmentation: Segmentation, target: perception.Candidate | None) -> np.ndarray:
+    """(H, W) bool: the pixels that see the planned object (:attr:`ImageGraspPlan.seen`)."""
+    return segmentation.mask if target is None else target.mask
+
 
 def plan_frame(
     rgb,
@@ -169,7 +180,7 @@ def plan_frame(
     roi=None,
     T_base_camera=None,
     colour_intrinsics: Intrinsics | None = None,
-    memory: GraspMemory | None = None,
+    memory: GraspMemory | SceneMemory | None = None,
 ) -> ImageGraspPlan:
     """Plan a grasp on one RGB-D frame with a :class:`~contourgrasp.hand.Hand`.
 
@@ -206,12 +217,15 @@ def plan_frame(
     colour_intrinsics : Intrinsics, optional
         The colour camera's, when ``rgb`` has another resolution than ``depth`` and not the same view
         scaled.
-    memory : GraspMemory, optional
+    memory : GraspMemory or SceneMemory, optional
         The grasps of this object that failed (:class:`~contourgrasp.synthesis.memory.GraspMemory`): no
         pose near one, in the object's frame as it is seen now, is planned, nor a side or tilted direction near
         one that failed, and the approach kinds that failed fewer times are tried first (:func:`approach_order`).
         After a failure, keep ``memory.with_failure(result.metric.contour_xy, result.plan.pose,
-        approach=result.approach)`` for the next plan.
+        approach=result.approach)`` for the next plan. A :class:`~contourgrasp.synthesis.SceneMemory` (a scene of
+        several objects, a camera that stays put) gives the memory of the object planned on, found by where it is
+        seen; keep ``memory.with_failure(result.seen, result.metric.contour_xy, result.plan.pose,
+        approach=result.approach)``.
 
     Notes
     -----
@@ -242,8 +256,9 @@ def plan_frame(
         raise HandError(f"hand must be a contourgrasp.Hand, got {type(hand).__name__}")
     if not isinstance(options, PlanOptions):
         raise PlannerError(f"options must be a contourgrasp.pipeline.PlanOptions, got {type(options).__name__}")
-    if memory is not None and not isinstance(memory, GraspMemory):
-        raise PlannerError(f"memory must be a contourgrasp.synthesis.GraspMemory, got {type(memory).__name__}")
+    if memory is not None and not isinstance(memory, GraspMemory | SceneMemory):
+        raise PlannerError(f"memory must be a contourgrasp.synthesis.GraspMemory or SceneMemory, "
+                           f"got {type(memory).__name__}")
     if T_base_camera is not None:
         T_base_camera = validation.rigid_transform("T_base_camera", T_base_camera, error=PerceptionError,
                                                    rotation_tolerance=ROTATION_TOLERANCE,
@@ -254,6 +269,8 @@ def plan_frame(
             rgb, depth, intrinsics, options.perception, mask=mask, target_px=target_px, roi=roi,
             max_width=perception.hand_opening(hand), colour_intrinsics=colour_intrinsics)
         heights = scene_heights(d, intrinsics, seg, metric, plane=table)
+    if isinstance(memory, SceneMemory):  # the memory of the object planned on
+        memory = memory.of(_seen(seg, scene[1]))
     asked = _grasp_height(hand, heights, scene_options)
     spec = (Descent(heights, *asked, sweep=scene_options.closing_sweep, closing=scene_options.closing_obstacles)
             if scene_options.descent and asked is not None else None)

@@ -242,6 +242,11 @@ MEMORY_TURN = _radians(20.0)
 MEMORY_ROUND = 0.1
 #: A memory keeps at most this many failures, the oldest dropped first (bounds the work a memory can ask for).
 MAX_MEMORY_FAILURES = 32
+#: A scene's memory (synthesis.SceneMemory) finds an object again where it is seen within this many pixels of where
+#: it was seen at its last failure (a failed grasp moves it a little) ...
+MEMORY_SAME_OBJECT_PX = 20
+#: ... and keeps at most this many objects, the one that failed longest ago dropped first.
+MAX_MEMORY_OBJECTS = 32
 
 #: The distance over which ``Safeguards.centring_gain`` costs its gain once, m (``synthesis.cost.centring_distance``).
 CENTRING_SCALE = 0.01

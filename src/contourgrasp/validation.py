@@ -138,6 +138,16 @@ def finite_array(name: str, value, shape: tuple[int | None, ...] | None = None, 
     return array
 
 
+def pixel_mask(name: str, value, *, error: type[InputError] = InputError) -> np.ndarray:
+    """``value`` as a non-empty (H, W) bool mask: an array of 0 and 1 (or bools) with at least one pixel set."""
+    array = finite_array(name, value, (None, None), error=error)
+    if not np.isin(array, (0.0, 1.0)).all():
+        raise error(f"{name} must be a mask of 0 and 1 (or bools)")
+    if not array.any():
+        raise error(f"{name} is empty: no pixel is set")
+    return array.astype(bool)
+
+
 def same_size(shape_a, shape_b, name_a: str = "rgb image", name_b: str = "depth image", *,
               error: type[InputError] = InputError) -> None:
     """Two images of the same width and height."""

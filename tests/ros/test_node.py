@@ -466,7 +466,7 @@ def test_a_failure_reported_is_avoided_by_the_next_plan_and_a_success_or_a_clear
         camera.send(node, colour, depth, info)
         first = json.loads(camera.call().message)
         failed = _call(camera, SetBool, "/memory/contourgrasp/report_outcome", SetBool.Request(data=False))
-        assert failed.success and "avoid the 1 failed grasp(s)" in failed.message and len(node.memory) == 1
+        assert failed.success and "avoid its 1 failed grasp(s)" in failed.message and len(node.memory) == 1
         second = json.loads(camera.call().message)
         step = np.subtract([second["pose"][k] for k in ("x", "y", "yaw")], [first["pose"][k] for k in ("x", "y", "yaw")])
         turn = abs((step[2] + np.pi) % (2 * np.pi) - np.pi)

@@ -56,20 +56,6 @@ def test_two_grasps_on_air_told_by_the_joints_end_the_run_the_second_on_another_
     assert not first_seen[second_pixel[1], second_pixel[0]]  # ... an object no grasp failed on
 
 
-def test_a_failure_is_remembered_on_its_object_and_an_object_failed_on_is_planned_with_its_memory():
-    from contourgrasp.sim.clearing import _memory_of, _with_failure
-
-    planner = make_planner("default", HAND)
-    scene = build_clutter("can", POOL, kind="clutter", seed=1)
-    rgb, depth = render(scene, seed=1)
-    planned = planner.plan(rgb, depth, scene.camera.intrinsics)
-    failed = _with_failure((), planned)
-    failed = _with_failure(failed, planned)  # the same object again: one record, two failures
-    assert len(failed) == 1 and len(failed[0].memory) == 2
-    assert len(_memory_of(planned.seen, failed)) == 2
-    assert len(_memory_of(np.roll(planned.seen, 200, axis=1), failed)) == 0  # 200 px aside: another object
-
-
 class _NoPlan:
     """Never has a plan; keeps the target pixel of every call."""
 

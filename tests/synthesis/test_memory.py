@@ -97,6 +97,22 @@ def test_the_next_plan_of_the_bundled_frame_avoids_the_failed_one():
         cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, yaw_step=0.1, memory=[first.plan.pose])
 
 
+def test_a_scene_memory_gives_the_plan_its_objects_failures_and_not_another_objects():
+    from contourgrasp.synthesis import SceneMemory
+
+    frame = read_rgbd(FRAME / "color_0.png", FRAME / "depth_0.npy", FRAME / "primesense_overhead_color.intr")
+    first = cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, yaw_step=0.1)
+    failed = dict(approach=first.approach)
+    on_it = SceneMemory().with_failure(first.seen, first.metric.contour_xy, first.plan.pose, **failed)
+    elsewhere = np.zeros_like(first.seen)
+    elsewhere[:20, :20] = True  # an object in the image's corner, away from the planned one
+    on_another = SceneMemory().with_failure(elsewhere, first.metric.contour_xy, first.plan.pose, **failed)
+    avoided = cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, yaw_step=0.1, memory=on_it)
+    assert not np.allclose(avoided.plan.pose, first.plan.pose)
+    same = cg.plan_grasp(frame.rgb, frame.depth, frame.intrinsics, yaw_step=0.1, memory=on_another)
+    np.testing.assert_array_equal(same.plan.pose, first.plan.pose)
+
+
 def test_a_failed_direction_is_avoided_of_its_kind_both_ways_round_the_axis_and_turns_with_the_object():
     from contourgrasp.perception import Approach
 
@@ -150,3 +166,50 @@ def test_the_kinds_that_failed_fewer_times_are_tried_first():
     twice = once.with_failure(square, (0.0, 0.0, 0.0), approach="tilted")
     assert approach_order("top+tilted+side", twice) == ["side", "top", "tilted"]
     assert approach_order("top", twice) == ["top"]
+
+
+def _blob(u, v, shape=(120, 160), half=10):
+    mask = np.zeros(shape, dtype=bool)
+    mask[max(v - half, 0):v + half, max(u - half, 0):u + half] = True
+    return mask
+
+
+def test_a_scene_memory_keeps_each_objects_failures_and_finds_an_object_moved_a_little():
+    from contourgrasp.synthesis import SceneMemory
+
+    square = np.array([[0.0, 0.0], [0.04, 0.0], [0.04, 0.02], [0.0, 0.02]])
+    left, right = _blob(40, 60), _blob(120, 60)
+    memory = SceneMemory()
+    for seen in (left, right, left):
+        memory = memory.with_failure(seen, square, (0.0, 0.0, 0.0))
+    assert len(memory) == 3 and len(memory.objects) == 2
+    assert len(memory.of(left)) == 2 and len(memory.of(right)) == 1
+    assert len(memory.of(_blob(40 + 25, 60))) == 2  # pushed 25 px: its edge 15 px from where its middle was
+    assert len(memory.of(_blob(40 + 35, 60))) == 0  # 35 px: another object (MEMORY_SAME_OBJECT_PX is 20)
+    assert len(memory.without(left)) == 1 and len(memory.without(left).of(left)) == 0
+
+
+def test_a_scene_memory_keeps_its_latest_objects():
+    from contourgrasp.synthesis import SceneMemory
+    from contourgrasp.tolerances import MAX_MEMORY_OBJECTS
+
+    square = np.array([[0.0, 0.0], [0.04, 0.0], [0.04, 0.02], [0.0, 0.02]])
+    blobs = [_blob(5 + 50 * (k % 30), 5 + 50 * (k // 30), shape=(200, 1600), half=3) for k in range(MAX_MEMORY_OBJECTS + 2)]
+    memory = SceneMemory()
+    for blob in blobs:
+        memory = memory.with_failure(blob, square, (0.0, 0.0, 0.0))
+    assert len(memory.objects) == MAX_MEMORY_OBJECTS
+    assert [len(memory.of(blob)) for blob in (blobs[0], blobs[1], blobs[2], blobs[-1])] == [0, 0, 1, 1]
+
+
+@pytest.mark.parametrize("seen, message", [
+    (np.zeros((4, 4), bool), "empty"), (np.full((4, 4), 2.0), "0 and 1"), (np.ones(4, bool), "(n, n)"),
+    ("mask", "numbers"),
+])
+def test_a_bad_mask_is_refused_by_name(seen, message):
+    from contourgrasp.synthesis import SceneMemory
+
+    square = np.array([[0.0, 0.0], [0.04, 0.0], [0.04, 0.02], [0.0, 0.02]])
+    with pytest.raises(PlannerError, match=message) as raised:
+        SceneMemory().with_failure(seen, square, (0.0, 0.0, 0.0))
+    assert "seen" in str(raised.value)

@@ -40,6 +40,7 @@ from __future__ import annotations
 
 from ..errors import PerceptionError, PerceptionWarning, SegmentationError
 from ._frame import one_frame
+from ._pixels import deepest_pixel
 from .camera import Intrinsics, as_depth, backproject, colour_on_depth, denoised_depth, fill_depth_holes, valid_depth
 from .candidates import TARGET_RULES, Candidate, choose_target, find_candidates, hand_opening, low_part_candidate
 from .colour import add_flat_parts, colour_offset, register_colour
@@ -60,6 +61,6 @@ __all__ = [
     "Approach", "ApproachView", "Candidate", "DEPTH_MODES", "DepthMode", "HeightMap", "Intrinsics", "MetricContour", "PerceptionError", "PerceptionOptions", "PerceptionWarning", "Plane",
     "SEGMENT_METHODS", "SegmentMethod", "Segmentation", "SegmentationError", "Support", "TARGET_RULES", "add_flat_parts", "approach_depth",
     "as_depth", "backproject", "choose_target", "colour_on_depth", "colour_offset", "contour_to_metric", "denoised_depth", "fill_depth_holes",
-    "cross_section", "find_candidates", "find_support", "fit_plane", "fit_table_plane", "hand_opening", "height_map", "hidden_side", "low_part_candidate", "mask_contour", "object_footprint", "one_frame", "open_table_holes", "register_colour", "segment",
+    "cross_section", "deepest_pixel", "find_candidates", "find_support", "fit_plane", "fit_table_plane", "hand_opening", "height_map", "hidden_side", "low_part_candidate", "mask_contour", "object_footprint", "one_frame", "open_table_holes", "register_colour", "segment",
     "segment_depth", "segment_from_mask", "segment_rgb", "split_touching", "valid_depth", "view_along",
 ]

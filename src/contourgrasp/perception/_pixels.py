@@ -69,6 +69,14 @@ def stats_in_image(boxes, centroids, origin):
     return boxes, sums / np.maximum(area, 1)
 
 
+def deepest_pixel(mask) -> tuple[int, int]:
+    """The pixel (u, v) of a non-empty (H, W) bool ``mask`` farthest from its edge (a distance transform's maximum,
+    the first in image order on ties): where to click on an object."""
+    distance = cv2.distanceTransform(np.pad(np.asarray(mask, dtype=np.uint8), 1), cv2.DIST_L2, 5)[1:-1, 1:-1]
+    v, u = np.unravel_index(int(np.argmax(distance)), distance.shape)
+    return int(u), int(v)
+
+
 def disc(radius):
     """OpenCV's elliptic structuring element of ``radius`` px."""
     return cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * radius + 1, 2 * radius + 1))

@@ -7,12 +7,12 @@ within ``pair_tolerance`` seconds; a frame without a pair is not planned on.
 
 Serves ``~/plan`` (std_srvs/Trigger): plans on the newest pair and answers the
 plan JSON of ``contourgrasp plan``, or success false with the one-line reason.
-The node keeps one memory of failed grasps for its scene
-(:class:`~contourgrasp.synthesis.GraspMemory`), which every plan avoids:
-``~/report_outcome`` (std_srvs/SetBool) tells it how the last grasp published
-went -- ``data`` false: it failed, and is remembered in the object's frame;
-true: it succeeded, the object is gone and the memory is cleared -- and
-``~/clear_memory`` (std_srvs/Trigger) clears it (a new scene).
+The node keeps a memory of failed grasps per object of its scene
+(:class:`~contourgrasp.synthesis.SceneMemory`: each object's found again by where the camera sees it), which
+every plan of that object avoids: ``~/report_outcome`` (std_srvs/SetBool) tells it how the last grasp
+published went -- ``data`` false: it failed, and is remembered on its object, in the object's frame;
+true: it succeeded, the object is gone and its memory forgotten -- and ``~/clear_memory``
+(std_srvs/Trigger) clears every object's (a new scene).
 With ``continuous`` it plans every pair as it arrives. Parameter ``target``
 ([u, v], a pixel of the depth image; ``[-1, -1]`` for the default rule of
 :func:`contourgrasp.perception.choose_target`) names the object to plan on;
@@ -50,7 +50,7 @@ from ..io.hand_file import load_hand
 from ..io.plan_file import image_plan_to_dict
 from ..io.planner_file import Planner, load_planner
 from ..pipeline import PlanOptions, approaches_supported, plan_frame
-from ..synthesis import GraspMemory
+from ..synthesis import SceneMemory
 from ..threads import one_blas_thread
 from ..validation import with_options
 from . import messages
@@ -170,8 +170,8 @@ class ContourGraspNode(Node):
     latencies_ms : deque of float
         Per plan published, the last ``LATENCIES_KEPT``: time from the message that completed the frame
         (continuous) or the service call to the poses published, ms.
-    memory : GraspMemory
-        The scene's failed grasps (module docstring).
+    memory : SceneMemory
+        The scene's failed grasps, per object (module docstring).
     last : ImageGraspPlan or None
         The last plan published, which ``~/report_outcome`` is about.
 
@@ -196,7 +196,7 @@ class ContourGraspNode(Node):
         self.grasp_publisher = self.create_publisher(PoseStamped, "~/grasp", 10)
         self.pregrasp_publisher = self.create_publisher(PoseStamped, "~/pregrasp", 10)
         self.markers_publisher = self.create_publisher(MarkerArray, "~/markers", 10)
-        self.memory, self.last = GraspMemory(), None
+        self.memory, self.last = SceneMemory(), None
         self.create_service(Trigger, "~/plan", self._on_plan)
         self.create_service(SetBool, "~/report_outcome", self._on_report_outcome)
         self.create_service(Trigger, "~/clear_memory", self._on_clear_memory)
@@ -263,23 +263,26 @@ class ContourGraspNode(Node):
         return response
 
     def _on_report_outcome(self, request, response):
-        """The last grasp published failed (``data`` false: remembered) or succeeded (true: the memory cleared)."""
+        """The last grasp published failed (``data`` false: remembered on its object) or succeeded (true: its object's
+        memory forgotten)."""
         if self.last is None:
             response.success, response.message = False, "no grasp published since the memory was last cleared"
         elif request.data:
-            self.memory, self.last = GraspMemory(), None
-            response.success, response.message = True, "the grasp succeeded: the memory of failed grasps is cleared"
+            self.memory, self.last = self.memory.without(self.last.seen), None
+            response.success, response.message = True, "the grasp succeeded: its object's failed grasps are forgotten"
         else:
-            self.memory = self.memory.with_failure(self.last.metric.contour_xy, self.last.plan.pose,
+            seen = self.last.seen
+            self.memory = self.memory.with_failure(seen, self.last.metric.contour_xy, self.last.plan.pose,
                                                    approach=self.last.approach)
             self.last = None  # reported once
             response.success, response.message = True, (
-                f"the grasp failed: remembered; the next plans avoid the {len(self.memory)} failed grasp(s)")
+                f"the grasp failed: remembered on its object; its next plans avoid its {len(self.memory.of(seen))} "
+                f"failed grasp(s)")
         self.get_logger().info(response.message)
         return response
 
     def _on_clear_memory(self, _request, response):
-        self.memory, self.last = GraspMemory(), None
+        self.memory, self.last = SceneMemory(), None
         response.success, response.message = True, "the memory of failed grasps is cleared"
         self.get_logger().info(response.message)
         return response

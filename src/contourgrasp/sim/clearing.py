@@ -11,8 +11,9 @@ failed, at most :data:`ATTEMPTS_PER_OBJECT` attempts per object in the scene. Ea
    rectangle no wider than the hand opens: :func:`~contourgrasp.perception.hand_opening`;
    :func:`~contourgrasp.pipeline.find_objects`, at most :data:`MAX_CANDIDATES`, each at the pixel deepest
    inside it), those no grasp failed on first, then those with the fewest failures, until one has a
-   plan; each object is planned with the memory of the grasps that failed on it (an object is the one a
-   failure was on when it stands within :data:`SAME_OBJECT_PX` of where that failure's object stood).
+   plan; each object is planned with the memory of the grasps that failed on it
+   (:class:`~contourgrasp.synthesis.SceneMemory`: an object is the one a failure was on when it stands within
+   ``tolerances.MEMORY_SAME_OBJECT_PX`` of where that failure's object stood).
    Nothing planned ends the run;
 3. the grasp is executed on the object the plan is on (the one most of the plan's pixels see), the
    others its neighbours; the closed hand carries what it holds out of view;
@@ -21,7 +22,7 @@ failed, at most :data:`ATTEMPTS_PER_OBJECT` attempts per object in the scene. Ea
    a load on the wrist),
    as a robot's encoders and wrist sensor tell it. Told it holds: whatever it holds is put away
    (:meth:`~contourgrasp.sim.scene.Scene.remove`). Told empty: the hand leaves, and the grasp that failed is
-   remembered on its object (:class:`~contourgrasp.synthesis.GraspMemory`);
+   remembered on its object;
 5. an object knocked off the table (or out of the bin) is lost: removed, not cleared.
 
 What counts, as in VGN: an attempt succeeds when the hand has taken an object off the table -- after
@@ -43,17 +44,15 @@ from __future__ import annotations
 
 import time
 import warnings
-from dataclasses import dataclass
 
-import cv2
 import numpy as np
 
 from .. import perception, pipeline
+from ..perception import deepest_pixel
 from ..errors import ContourGraspWarning, InputError, NoFeasibleGrasp, SimulationError
 from ..hand import Hand
-from ..synthesis import GraspMemory
+from ..synthesis import SceneMemory
 from ..validation import choice
-from .clutter import deepest_pixel
 from .detect import hand_holds
 from .render import DEFAULT_SENSOR, Sensor, render, truth_labels
 from .scene import Camera, Workspace
@@ -67,8 +66,6 @@ FAILURES_IN_A_ROW = 2
 ATTEMPTS_PER_OBJECT = 3
 #: At most this many objects are asked about when the planner's own choice has no plan.
 MAX_CANDIDATES = 6
-#: A failed grasp's object is the object standing within this many pixels of where it stood (it may have been pushed).
-SAME_OBJECT_PX = 20
 #: How a clearing run ended (:attr:`TrialRecord.ended`).
 CLEARED, NOTHING_PLANNED, FAILED_IN_A_ROW, ATTEMPT_LIMIT = ("table cleared", "nothing to plan on",
                                                             "failed twice in a row", "attempt limit")
@@ -96,7 +93,7 @@ def run_clearing(object_spec, *, seed: int, planner, pool, scene_kind: str = "cl
                               "(contourgrasp.sim.planners)")
     scene = trial_scene(object_spec, seed=seed, scene_kind=scene_kind, pool=pool, planner=planner, tilt=tilt,
                         hand=hand, design=design, timing=timing, camera=camera, workspace=workspace, robot=robot)
-    failed, outcomes, detected, cleared, in_a_row, plan_time = (), [], [], 0, 0, 0.0
+    memory, outcomes, detected, cleared, in_a_row, plan_time = SceneMemory(), [], [], 0, 0, 0.0
     fields, plan_error, ended, failure = dict(NO_PLAN_FIELDS), None, ATTEMPT_LIMIT, HIT
     for attempt in range(ATTEMPTS_PER_OBJECT * len(scene.objects)):
         _remove_lost(scene)
@@ -104,7 +101,7 @@ def run_clearing(object_spec, *, seed: int, planner, pool, scene_kind: str = "cl
             ended = CLEARED
             break
         rgb, depth = render(scene, sensor=sensor, seed=seed if attempt == 0 else noise_seed(seed, attempt))
-        planned, plan_error, spent = _plan_next(planner, rgb, depth, scene.camera.intrinsics, failed)
+        planned, plan_error, spent = _plan_next(planner, rgb, depth, scene.camera.intrinsics, memory)
         plan_time += spent
         if planned is None:
             fields, ended, failure = dict(NO_PLAN_FIELDS), NOTHING_PLANNED, NO_PLAN
@@ -116,7 +113,9 @@ def run_clearing(object_spec, *, seed: int, planner, pool, scene_kind: str = "cl
         if told:
             cleared, in_a_row = cleared + len(held), 0
         else:
-            failed, in_a_row = _with_failure(failed, planned), in_a_row + 1
+            memory = memory.with_failure(_planned_pixels(planned), planned.metric.contour_xy, planned.pose,
+                                         approach=planned.approach)
+            in_a_row += 1
         if in_a_row == FAILURES_IN_A_ROW:
             ended = FAILED_IN_A_ROW
             break
@@ -148,26 +147,7 @@ def _pick(scene, planned, execution) -> tuple[dict, list[int], bool]:
     return fields, held, told
 
 
-@dataclass(frozen=True)
-class _Failed:
-    """An object a grasp failed on: the pixel (u, v) deepest inside the pixels that saw it, and its memory."""
-
-    pixel: tuple[int, int]
-    memory: GraspMemory
-
-
-def _with_failure(failed: tuple[_Failed, ...], planned) -> tuple[_Failed, ...]:
-    """``failed`` with ``planned``'s grasp remembered: on the object it was planned on, added to that object's
-    memory when an earlier failure lies on it, else a new object's."""
-    mask = _planned_pixels(planned)
-    pixel = deepest_pixel(mask)
-    same = [f for f in failed if _on(mask, f.pixel)]
-    memory = (same[-1].memory if same else GraspMemory()).with_failure(planned.metric.contour_xy, planned.pose,
-                                                                       approach=planned.approach)
-    return (*(f for f in failed if f not in same), _Failed(pixel, memory))
-
-
-def _plan_next(planner, rgb, depth, intrinsics, failed: tuple[_Failed, ...]):
+def _plan_next(planner, rgb, depth, intrinsics, memory: SceneMemory):
     """(PlannedGrasp or None, the last planning error or None, seconds): before any failure the planner's own
     choice of object; then, or when it has no plan, every object standing wholly in view that the hand spans
     (a bin's walls and what touches them do not), those no grasp failed on first (fewest failures first, then
@@ -175,9 +155,9 @@ def _plan_next(planner, rgb, depth, intrinsics, failed: tuple[_Failed, ...]):
     started, error = time.perf_counter(), None
     with warnings.catch_warnings():  # a run's record is its outcome: its perception's notes are not printed
         warnings.simplefilter("ignore", ContourGraspWarning)
-        if not failed:
+        if not memory.objects:
             try:
-                return planner.plan(rgb, depth, intrinsics, memory=GraspMemory()), None, time.perf_counter() - started
+                return planner.plan(rgb, depth, intrinsics, memory=memory), None, time.perf_counter() - started
             except (NoFeasibleGrasp, InputError) as err:
                 error = str(err)
         try:
@@ -186,26 +166,13 @@ def _plan_next(planner, rgb, depth, intrinsics, failed: tuple[_Failed, ...]):
             return None, str(err), time.perf_counter() - started
         width = perception.hand_opening(planner.hand)
         spanned = [c for c in candidates if c.in_view and c.extent[1] <= width][:MAX_CANDIDATES]
-        for candidate, memory in sorted(((c, _memory_of(c.mask, failed)) for c in spanned), key=lambda c: len(c[1])):
+        for candidate, own in sorted(((c, memory.of(c.mask)) for c in spanned), key=lambda c: len(c[1])):
             try:
-                planned = planner.plan(rgb, depth, intrinsics, memory=memory, target_px=deepest_pixel(candidate.mask))
+                planned = planner.plan(rgb, depth, intrinsics, memory=own, target_px=deepest_pixel(candidate.mask))
                 return planned, None, time.perf_counter() - started
             except (NoFeasibleGrasp, InputError) as err:
                 error = str(err)
     return None, error, time.perf_counter() - started
-
-
-def _memory_of(mask, failed: tuple[_Failed, ...]) -> GraspMemory:
-    """The memory of the last failure on the object whose pixels are ``mask``; empty when none lies on it."""
-    return next((f.memory for f in reversed(failed) if _on(mask, f.pixel)), GraspMemory())
-
-
-def _on(mask, pixel) -> bool:
-    """Whether ``pixel`` (u, v) lies within ``SAME_OBJECT_PX`` of ``mask``'s pixels: the same object, moved a little."""
-    near = cv2.dilate(np.asarray(mask, dtype=np.uint8), cv2.getStructuringElement(
-        cv2.MORPH_ELLIPSE, (2 * SAME_OBJECT_PX + 1,) * 2)) > 0
-    u, v = pixel
-    return bool(near[v, u])
 
 
 def _planned_pixels(planned) -> np.ndarray:

@@ -46,10 +46,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import cv2
 import numpy as np
 
 from ..errors import SimulationError
+from ..perception import deepest_pixel
 from ..hand import Hand
 from ..io.hand_file import load_hand
 from ..validation import choice
@@ -252,9 +252,3 @@ def target_pixel(scene: Scene) -> tuple[int, int]:
     return deepest_pixel(mask)
 
 
-def deepest_pixel(mask) -> tuple[int, int]:
-    """The pixel (u, v) of a non-empty (H, W) bool ``mask`` farthest from its edge (a distance transform's maximum,
-    the first in image order on ties)."""
-    distance = cv2.distanceTransform(np.pad(mask, 1).astype(np.uint8), cv2.DIST_L2, 5)[1:-1, 1:-1]
-    v, u = np.unravel_index(int(np.argmax(distance)), distance.shape)
-    return int(u), int(v)

@@ -17,7 +17,7 @@
 * :mod:`~contourgrasp.synthesis.options` — the search's options and the 3-D hand's (:class:`SearchOptions`,
   :class:`SceneOptions`);
 * :mod:`~contourgrasp.synthesis.memory` — the grasps that failed, avoided by the next search in the
-  object's frame (:class:`GraspMemory`, :func:`object_frame`);
+  object's frame (:class:`GraspMemory`, :func:`object_frame`), one per object of a scene (:class:`SceneMemory`);
 * :mod:`~contourgrasp.synthesis.outer` — the search itself (eq 3.32, :func:`search`);
 * :mod:`~contourgrasp.synthesis.plan` — what it returns (:class:`GraspPlan`, :class:`Cost`, ...).
 
@@ -29,7 +29,7 @@ from .descent import Descent, DescentCheck, descent_clearance, descent_feasible,
 from .evaluate import evaluate_poses
 from .grid import SearchGrid, distinct_best, screen_grid, screen_reaching
 from .inner import closest_approach, first_touch
-from .memory import GraspMemory, object_frame
+from .memory import GraspMemory, SceneMemory, object_frame
 from .options import SceneOptions, SearchOptions
 from .outer import search
 from .plan import Alternative, Cost, FingerContact, GraspPlan, Refinement
@@ -37,7 +37,7 @@ from .refine import refine_poses
 from .safeguards import Safeguards, fingers_clear, grasp_epsilon, grasp_imbalance
 
 __all__ = [
-    "Alternative", "Cost", "Descent", "DescentCheck", "FingerContact", "GraspMemory", "GraspPlan", "PoseEvaluation", "Refinement", "Safeguards", "SceneOptions", "SearchOptions",
+    "Alternative", "Cost", "Descent", "DescentCheck", "FingerContact", "GraspMemory", "GraspPlan", "PoseEvaluation", "Refinement", "Safeguards", "SceneMemory", "SceneOptions", "SearchOptions",
     "SearchGrid", "closest_approach", "descent_clearance", "descent_feasible", "descent_floor", "distance", "distinct_best", "evaluate_poses", "fingers_clear",
     "first_touch", "grasp_epsilon", "grasp_imbalance", "object_frame", "ratio_cost", "refine_poses", "screen_grid", "screen_reaching", "search",
 ]

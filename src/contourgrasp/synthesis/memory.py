@@ -11,6 +11,11 @@ ball) has no axis that turns with it, and its frame keeps the planning frame's o
 :func:`contourgrasp.pipeline.plan_frame` takes a :class:`GraspMemory` (``memory=``), which
 :func:`~contourgrasp.synthesis.search` applies to its screened poses (``exclude=``).
 
+A scene of several objects, seen by a camera that stays put (a lab's table, a bin), keeps one memory per object:
+:class:`SceneMemory` finds an object's memory again by where the object is seen, the pixel deepest inside it at
+its last failure lying within ``tolerances.MEMORY_SAME_OBJECT_PX`` of the pixels that see it now, so that a
+failure on one object excludes nothing on its neighbour. ``plan_frame`` takes either.
+
 A grasp approached from the side or tilted (:mod:`contourgrasp.perception.view_along`) is kept as its
 kind of approach and its direction: the next plan tries the kinds that failed fewer times first
 (:func:`contourgrasp.pipeline.approach_order`), and of a kind, no direction within
@@ -29,8 +34,10 @@ import numpy as np
 
 from .. import validation
 from ..errors import PlannerError
+from ..perception import deepest_pixel
 from ..perception.view_along import APPROACH_KINDS, Approach
-from ..tolerances import MAX_MEMORY_FAILURES, MEMORY_REACH, MEMORY_ROUND, MEMORY_TURN
+from ..tolerances import (MAX_MEMORY_FAILURES, MAX_MEMORY_OBJECTS, MEMORY_REACH, MEMORY_ROUND, MEMORY_SAME_OBJECT_PX,
+                          MEMORY_TURN)
 
 
 @dataclass(frozen=True)
@@ -105,6 +112,60 @@ class GraspMemory:
         _, angle = object_frame(contour_xy)
         turns = np.add.outer(np.asarray(failed), [angle, angle + np.pi])  # the axis has no sign
         return bool((np.abs(_wrapped(approach.azimuth - turns)) <= MEMORY_TURN).any())
+
+
+@dataclass(frozen=True)
+class SceneMemory:
+    """The failed grasps of the objects of one scene, seen by a camera that stays put: each object's own
+    :class:`GraspMemory`, found again by where the object is seen (module docstring).
+
+    ``objects`` holds per object the pixel (u, v) deepest inside it as seen at its last failure and its memory,
+    the one that failed longest ago first; at most ``tolerances.MAX_MEMORY_OBJECTS``. Immutable.
+
+    Examples
+    --------
+    >>> left, right = np.zeros((40, 60), bool), np.zeros((40, 60), bool)
+    >>> left[10:30, 5:25] = right[10:30, 35:55] = True
+    >>> square = np.array([[0.0, 0.0], [0.04, 0.0], [0.04, 0.02], [0.0, 0.02]])
+    >>> memory = SceneMemory().with_failure(left, square, (0.02, 0.05, 0.0))
+    >>> len(memory.of(left)), len(memory.of(right))
+    (1, 0)
+    """
+
+    objects: tuple[tuple[tuple[int, int], GraspMemory], ...] = ()
+
+    def __len__(self) -> int:
+        """The failures remembered, on every object."""
+        return sum(len(memory) for _, memory in self.objects)
+
+    def of(self, seen) -> GraspMemory:
+        """The memory of the object whose pixels are ``seen`` ((H, W) bool); empty when no failure lies on it."""
+        near = _near(validation.pixel_mask("seen", seen, error=PlannerError), self.objects)
+        return next((memory for (_, memory), on in zip(reversed(self.objects), near[::-1]) if on), GraspMemory())
+
+    def with_failure(self, seen, contour_xy, pose, *, approach: str | Approach = "top") -> SceneMemory:
+        """This memory and a failed grasp on the object whose pixels are ``seen`` ((H, W) bool, the plan's
+        ``seen``), added to that object's memory (:meth:`GraspMemory.with_failure`, the other arguments)."""
+        seen = validation.pixel_mask("seen", seen, error=PlannerError)
+        near = _near(seen, self.objects)
+        same = [memory for (_, memory), on in zip(self.objects, near) if on]
+        memory = (same[-1] if same else GraspMemory()).with_failure(contour_xy, pose, approach=approach)
+        others = tuple(entry for entry, on in zip(self.objects, near) if not on)
+        return SceneMemory((*others, (deepest_pixel(seen), memory))[-MAX_MEMORY_OBJECTS:])
+
+    def without(self, seen) -> SceneMemory:
+        """This memory without the object whose pixels are ``seen`` ((H, W) bool): it was taken away."""
+        near = _near(validation.pixel_mask("seen", seen, error=PlannerError), self.objects)
+        return SceneMemory(tuple(entry for entry, on in zip(self.objects, near) if not on))
+
+
+def _near(seen, objects) -> list[bool]:
+    """Per object of a :class:`SceneMemory`, whether its pixel lies within ``MEMORY_SAME_OBJECT_PX`` of the pixels
+    ``seen``: the same object, moved a little by the grasp that failed."""
+    grown = cv2.dilate(seen.astype(np.uint8), cv2.getStructuringElement(
+        cv2.MORPH_ELLIPSE, (2 * MEMORY_SAME_OBJECT_PX + 1,) * 2)) > 0
+    height, width = grown.shape
+    return [0 <= v < height and 0 <= u < width and bool(grown[v, u]) for (u, v), _ in objects]
 
 
 def object_frame(contour_xy) -> tuple[np.ndarray, float]:
