@@ -91,7 +91,8 @@ from ..hand import SLICE_CONTOUR, Hand, Palm, SampledChain  # noqa: E402
 from . import lookup  # noqa: E402
 from ..sim.calibrate import FingerTravel, derive_virtual_starts  # noqa: E402
 from .fit import FingerFit, fit_chain, fit_finger, palm_plate, sampled_chain, travelled  # noqa: E402
-from ..sim.scene import TIMESTEP, mujoco_warnings  # noqa: E402
+from ..sim.mjcf import TIMESTEP  # noqa: E402
+from ..sim.scene import mujoco_warnings  # noqa: E402
 
 #: Time the open hand settles before closing, s.
 SETTLE_TIME = 2.0

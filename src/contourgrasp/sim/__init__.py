@@ -5,7 +5,8 @@
 * :mod:`~contourgrasp.sim.materials` -- frictions, densities and colours by material
 * :mod:`~contourgrasp.sim.procedural` -- seeded objects the shapes of the YCB families (``procedural:N``)
 * :mod:`~contourgrasp.sim.tendon_hand` -- the one-motor, tendon-driven hand built from a preset
-* :mod:`~contourgrasp.sim.scene` -- table, object, top-down camera, hand
+* :mod:`~contourgrasp.sim.mjcf` -- the scene's MJCF: table, objects and their contacts, bin, robot arm, solver
+* :mod:`~contourgrasp.sim.scene` -- the scene as it runs: table, object, top-down camera, hand
 * :mod:`~contourgrasp.sim.clutter` -- scenes of several objects: clutter on the table, a bin, tilted cameras
 * :mod:`~contourgrasp.sim.render` -- RGB-D pictures by ray casting
 * :mod:`~contourgrasp.sim.trial` -- grasp execution and trials
@@ -36,7 +37,8 @@ from .procedural import procedural_object
 from .render import (BIN_LABEL, DEFAULT_SENSOR, SENSORS, Sensor, object_truth, render, render_view, sensor_named,
                      tilted_view, truth_labels)
 from ..perception import Intrinsics
-from .scene import ROBOT_ARM, SR300, Bin, Camera, HandReading, Placement, Scene, Workspace, build_scene
+from .mjcf import ROBOT_ARM, Bin, Placement
+from .scene import SR300, Camera, HandReading, Scene, Workspace, build_scene
 from .clutter import SCENE_KINDS, Arrangement, arrange, build_clutter, target_pixel
 from .trial import (DROPPED, FAILURE_CAUSES, HIT, MISSED, NO_PLAN, PUSHED, SLIPPED, STRUCK, Execution, GraspOutcome,
                     TrialRecord, execute_grasp, hand_pose_from_matrix, pose_matrix, run_trial, scripted_grasp)

@@ -61,7 +61,7 @@ from ..io.hand_file import load_hand
 from ..tolerances import CLOSED_WITHIN, CLOSING_TIE, FINGER_MOVED, TRAVEL_SAMPLES
 from .tendon_hand import HandDesign
 from .measure import fingertip_paths
-from .scene import TIMESTEP
+from .mjcf import TIMESTEP
 from .trial import Execution
 
 #: Decimals of a meter kept in calibrated virtual starts (0.1 mm): finer digits mean nothing to a 2-D hand model.

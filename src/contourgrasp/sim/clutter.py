@@ -6,7 +6,7 @@ Kinds (:data:`SCENE_KINDS`)
     ``clutter``
         2-4 objects on the table: the target and 1-3 neighbours.
     ``bin``
-        1-3 objects in a :class:`~contourgrasp.sim.scene.Bin` fixed on the table
+        1-3 objects in a :class:`~contourgrasp.sim.mjcf.Bin` fixed on the table
         (walls 10 cm high, floor 40 x 30 cm inside, 5 mm walls, 4 mm floor): the
         target and 0-2 neighbours.
 
@@ -29,7 +29,7 @@ Placement (:func:`arrange`), all from the seed (stream 3 of the trial's seed:
    neighbour without a spot is left out (rare: it takes a crowded bin).
 
 Outlines that are disjoint from above cannot interpenetrate, so the objects
-are then dropped from :data:`~contourgrasp.sim.scene.DROP_HEIGHT` and settle
+are then dropped from :data:`~contourgrasp.sim.mjcf.DROP_HEIGHT` and settle
 for :data:`CLUTTER_SETTLE` s, touching where they were placed touching (a
 tall object may topple onto its neighbour).
 
@@ -56,7 +56,8 @@ from ..validation import choice
 from .tendon_hand import HandDesign, build_hand
 from .objects import ObjectSpec, object_spec
 from .render import tilted_view, truth_labels
-from .scene import PARK_HEIGHT, Bin, Camera, Placement, Scene, Workspace, mujoco, mujoco_warnings, scene_xml
+from .mjcf import Bin, Placement, scene_xml
+from .scene import PARK_HEIGHT, Camera, Scene, Workspace, mujoco, mujoco_warnings
 
 #: The scenes a trial can take place in.
 SCENE_KINDS = ("single", "clutter", "bin")
@@ -220,7 +221,7 @@ def build_clutter(obj, pool, *, kind: str, seed: int, hand: Hand | str = "five-f
         Seconds the objects settle before anything looks at them, and longer while they still move
         (:meth:`~contourgrasp.sim.scene.Scene.settle`).
     robot : bool
-        A robot arm in view (:data:`~contourgrasp.sim.scene.ROBOT_ARM`).
+        A robot arm in view (:data:`~contourgrasp.sim.mjcf.ROBOT_ARM`).
     """
     obj = object_spec(obj)
     layout = arrange(kind, obj, [object_spec(o) for o in pool], seed=seed, workspace=workspace)

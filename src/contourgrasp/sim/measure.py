@@ -11,7 +11,7 @@ servo giving way to the fingers' reaction, joint compliance. These functions
 measure it.
 
 How much a hold inside its friction cones creeps (:func:`squeeze_creep`): the
-reason for :data:`~contourgrasp.sim.scene.IMPRATIO` (see :mod:`contourgrasp.sim.scene`).
+reason for :data:`~contourgrasp.sim.mjcf.IMPRATIO` (see :mod:`contourgrasp.sim.mjcf`).
 """
 
 from __future__ import annotations
@@ -27,7 +27,8 @@ from ..errors import SimulationError  # noqa: E402
 from ..hand import polyline_distance  # noqa: E402
 from .tendon_hand import HandDesign  # noqa: E402
 from .objects import ObjectSpec, Part  # noqa: E402
-from .scene import IMPRATIO, build_scene, grip_contact, solver_option  # noqa: E402
+from .mjcf import IMPRATIO, grip_contact, solver_option  # noqa: E402
+from .scene import build_scene  # noqa: E402
 
 #: Palm height for free-space closing: fingertips far above the table and the object.
 FREE_SPACE_HEIGHT = 0.6
@@ -83,8 +84,8 @@ def squeeze_creep(margin: float, *, impratio: float = IMPRATIO, noslip: int = 0,
                   hold_time: float = 2.0) -> float:
     """m: how far a box squeezed between two pads falls while gravity pulls it for ``hold_time`` s.
 
-    The scene's solver settings (:func:`~contourgrasp.sim.scene.solver_option`, with ``impratio`` and MuJoCo's
-    ``noslip_iterations`` as given) and its grip contact (:func:`~contourgrasp.sim.scene.grip_contact`);
+    The scene's solver settings (:func:`~contourgrasp.sim.mjcf.solver_option`, with ``impratio`` and MuJoCo's
+    ``noslip_iterations`` as given) and its grip contact (:func:`~contourgrasp.sim.mjcf.grip_contact`);
     the pads slide on rails and are pushed together with a constant force; the box of ``mass`` kg is
     squeezed at rest between them without gravity for 0.5 s before gravity is turned on. ``margin`` is the friction cone's limit over the load, mu 2F / (m g): above 1 Coulomb friction
     holds the box still, below 1 it slides.

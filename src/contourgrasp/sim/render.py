@@ -28,7 +28,8 @@ import numpy as np
 
 from ..errors import SimulationError
 from ..perception import Intrinsics
-from .scene import R_WORLD_CAMERA, Scene, mujoco, object_bodies
+from .mjcf import object_bodies
+from .scene import R_WORLD_CAMERA, Scene, mujoco
 
 #: Geom groups the camera sees: table and objects (0) and objects' drawn meshes (1), not the hand (2)
 #: nor collision-only pieces (3).

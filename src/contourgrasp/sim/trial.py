@@ -285,7 +285,7 @@ def run_trial(object_spec, *, seed: int, planner, hand: Hand | str = "five-finge
     pool : sequence of ObjectSpec
         The neighbours of a ``clutter`` or ``bin`` scene are drawn from it.
     robot : bool
-        A robot arm in the picture (:data:`~contourgrasp.sim.scene.ROBOT_ARM`), seen and never touched.
+        A robot arm in the picture (:data:`~contourgrasp.sim.mjcf.ROBOT_ARM`), seen and never touched.
     attempts : int
         At most this many attempts (above).
     """

@@ -55,7 +55,7 @@ class Bench:
         The camera's tilt from looking straight down, rad, for every trial (at most ``MAX_BENCH_TILT``);
         None: top-down for ``single`` scenes, the seed's 0-25 deg for ``clutter`` and ``bin``.
     robot : bool
-        A robot arm in every picture (:data:`~contourgrasp.sim.scene.ROBOT_ARM`), seen and never touched.
+        A robot arm in every picture (:data:`~contourgrasp.sim.mjcf.ROBOT_ARM`), seen and never touched.
     camera, workspace
         Scene parameters (:mod:`contourgrasp.sim.scene`).
     splits : tuple of (str, tuple of str)
