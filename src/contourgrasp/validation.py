@@ -140,8 +140,11 @@ def finite_array(name: str, value, shape: tuple[int | None, ...] | None = None, 
 
 def pixel_mask(name: str, value, *, error: type[InputError] = InputError) -> np.ndarray:
     """``value`` as a non-empty (H, W) bool mask: an array of 0 and 1 (or bools) with at least one pixel set."""
-    array = finite_array(name, value, (None, None), error=error)
-    if not np.isin(array, (0.0, 1.0)).all():
+    array = value if isinstance(value, np.ndarray) and value.dtype == bool else finite_array(
+        name, value, (None, None), error=error)
+    if array.ndim != 2:
+        raise error(f"{name} must be an (H, W) mask, got shape {array.shape}")
+    if array.dtype != bool and not ((array == 0.0) | (array == 1.0)).all():
         raise error(f"{name} must be a mask of 0 and 1 (or bools)")
     if not array.any():
         raise error(f"{name} is empty: no pixel is set")

@@ -203,7 +203,8 @@ def test_a_scene_memory_keeps_its_latest_objects():
 
 
 @pytest.mark.parametrize("seen, message", [
-    (np.zeros((4, 4), bool), "empty"), (np.full((4, 4), 2.0), "0 and 1"), (np.ones(4, bool), "(n, n)"),
+    (np.zeros((4, 4), bool), "empty"), (np.full((4, 4), 2.0), "0 and 1"), (np.ones(4, bool), "(H, W)"),
+    (np.ones(4), "(n, n)"),
     ("mask", "numbers"),
 ])
 def test_a_bad_mask_is_refused_by_name(seen, message):
