@@ -176,7 +176,7 @@ def _plan_next(planner, rgb, depth, intrinsics, memory: SceneMemory):
 
 
 def _planned_pixels(planned) -> np.ndarray:
-    """(H, W) bool: the pixels that saw the object a plan is on."""
+    """(H, W) bool: the pixels that saw the object a plan is on (a baseline's: its segmentation's mask)."""
     return np.asarray(planned.seen if planned.seen is not None else planned.segmentation.mask, dtype=bool)
 
 

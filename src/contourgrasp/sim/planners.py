@@ -107,8 +107,8 @@ class PlannedGrasp:
     grasp_height : float or None
         The planned height of the open tips above the table (None: the execution's own rule).
     seen : (H, W) bool or None
-        The pixels that see the object (the target candidate's), where perception chose one; a tilted
-        camera's ``segmentation`` is the object's footprint on the table instead.
+        The depth image's pixels that see the object (:attr:`contourgrasp.pipeline.ImageGraspPlan.seen`; a tilted
+        camera's ``segmentation`` is the object's footprint on the table, not these); None for a baseline.
     view : ApproachView or None
         A side or tilted plan's view (``pose`` is in its frame); None for a top-down plan.
     """
@@ -152,7 +152,7 @@ class SynthesisPlanner(_Planner):
                                      memory=memory)
         return PlannedGrasp(result.plan.pose, result.T_camera_hand, result.metric.approach_depth,
                             result.segmentation, result.metric, result.camera, result.plan, result.grasp_height,
-                            None if result.target is None else result.target.mask, result.view)
+                            result.seen, result.view)
 
 
 @dataclass(frozen=True)

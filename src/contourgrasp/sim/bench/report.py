@@ -340,6 +340,11 @@ def _groups(bench: Bench) -> list[tuple[str, tuple[str, ...]]]:
     return groups if len(groups) == 1 and set(groups[0][1]) == set(everything) else [*groups, ("all", everything)]
 
 
+def _groups_or_all(bench: Bench) -> list[tuple[str, tuple[str, ...]]]:
+    """:func:`_groups` of a bench with splits; every object as one group, "all", of one without."""
+    return _groups(bench) if bench.splits else [("all", tuple(o.name for o in bench.objects))]
+
+
 def _of(results, planner: str, members) -> list:
     return [r for r in records(results, planner) if r.object in members]
 
@@ -415,7 +420,7 @@ def attempts_section(bench: Bench, results) -> list[str]:
              "trial stops when the hand tells it holds the object), and the attempts made. Then every attempt "
              "made, its outcome as the hand told it (detected) against the simulator's (true).", ""]
     lines += _header("planner", ["group", "first attempt", f"within {bench.attempts}", "attempts per trial"], left=1)
-    groups = _groups(bench) if bench.splits else [("all", tuple(o.name for o in bench.objects))]
+    groups = _groups_or_all(bench)
     for planner in bench.planners:
         for group, members in groups:
             own = _of(results, planner, members)
@@ -448,7 +453,7 @@ def clearing_section(bench: Bench, results) -> list[str]:
              "each with its 95 % Wilson interval.", ""]
     lines += _header("planner", ["group", "success per attempt", "objects cleared", "attempts per object",
                                  "tables cleared"], left=1)
-    groups = _groups(bench) if bench.splits else [("all", tuple(o.name for o in bench.objects))]
+    groups = _groups_or_all(bench)
     for planner in bench.planners:
         for group, members in groups:
             own = _of(results, planner, members)
