@@ -327,7 +327,7 @@ def test_fuzz_the_command_line_never_tracebacks(fuzz_files):
 
 # --- hand-from-model ---
 
-@pytest.mark.parametrize("model", ["inspire", "jaco-three-finger"])
+@pytest.mark.parametrize("model", ["inspire", "jaco-three-finger", "mpl"])
 def test_hand_from_model_writes_a_hand_that_plans(tmp_path, capsys, model):
     hand = tmp_path / "hand.toml"
     code, out, err = run(capsys, "hand-from-model", model, "--out", hand)

@@ -306,7 +306,7 @@ def _add_bench_parser(sub) -> None:
     bench.add_argument("--resume", metavar="DIR",
                        help="continue the bench whose outputs are in DIR (same settings), keeping its trials")
     bench.add_argument("--hand-model", metavar="MODEL",
-                       help="simulate this MuJoCo hand model (MJCF file, or inspire, jaco-three-finger) and plan with "
+                       help="simulate this MuJoCo hand model (MJCF file, or inspire, jaco-three-finger, mpl) and plan with "
                             "the hand file derived from it (see hand-from-model), instead of --hand")
     bench.add_argument("--fingertips", nargs="+", metavar="SITE|BODY", help="with --hand-model FILE: see hand-from-model")
     bench.add_argument("--actuators", nargs="+", metavar="NAME", help="with --hand-model: see hand-from-model")
@@ -333,7 +333,7 @@ def _add_calibrate_parser(sub) -> None:
 
 def _add_hand_from_model_parser(sub) -> None:
     derive = sub.add_parser("hand-from-model", help="derive a hand file by closing a MuJoCo hand model (MJCF)")
-    derive.add_argument("model", metavar="MODEL", help="MJCF file, or a bundled model: inspire, jaco-three-finger")
+    derive.add_argument("model", metavar="MODEL", help="MJCF file, or a bundled model: inspire, jaco-three-finger, mpl")
     derive.add_argument("--fingertips", nargs="+", metavar="SITE|BODY",
                         help="one site or body per finger (required for a file)")
     derive.add_argument("--actuators", nargs="+", metavar="NAME",

@@ -1,3 +1,4 @@
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -88,8 +89,6 @@ def test_the_approach_axis_decides_the_palm_plane(sliders):
 
 
 def test_the_level_reading_brings_the_inspire_thumb_as_deep_as_its_fingers():
-    from dataclasses import replace
-
     from contourgrasp.handmodels.derive import LEVEL, record_closing, model_spec
 
     along = record_closing(replace(model_spec("inspire"), approach=None)).tips[:, 0, 2]  # open tips' depths, m
@@ -120,7 +119,7 @@ def test_level_keeps_a_hand_whose_tips_are_level_and_needs_two_fingers(sliders):
         _levelled(np.eye(3), np.array([[0.0, 0.0, 0.05], [0.0, 0.0, 0.1], [0.0, 0.0, 0.1]]), "tower.xml")
 
 
-@pytest.mark.parametrize("name, fingers", [("inspire", 5), ("jaco-three-finger", 3)])
+@pytest.mark.parametrize("name, fingers", [("inspire", 5), ("jaco-three-finger", 3), ("mpl", 5)])
 def test_bundled_models_derive_hands_within_the_tolerance(name, fingers):
     derived = derive_hand(name)
     assert len(derived.hand.fingers) == fingers and derived.hand.name == name
@@ -187,7 +186,26 @@ def test_bad_models_are_refused_naming_what(sliders, tmp_path):
         derive_hand(sliders)
     with pytest.raises(HandError, match="hold_time"):
         derive_hand(sliders, fingertips=["left_tip", "right_tip"], hold_time=1e6)  # a bound on the simulation asked for
-    assert set(MODELS) == {"inspire", "jaco-three-finger"}
+    assert set(MODELS) == {"inspire", "jaco-three-finger", "mpl"}
+
+
+def test_a_pre_flexed_hand_opens_part_of_the_way():
+    """open_from 0.5 starts the synergy halfway: the open controls halfway between the fully open and the closed ones,
+    and the open fingertips where the fully open hand's pass halfway through its closing (within the closing's step)."""
+    full, half = derive_hand("jaco-three-finger"), derive_hand(replace(MODELS["jaco-three-finger"], open_from=0.5))
+    opened, closed = np.array(full.mount.open_controls), np.array(full.mount.closed_controls)
+    np.testing.assert_allclose(half.mount.open_controls, opened + 0.5 * (closed - opened))
+    np.testing.assert_allclose(half.mount.closed_controls, closed)
+    assert all(h.travel < f.travel - 0.01 for h, f in zip(half.hand.fingers, full.hand.fingers))
+    for bad in (-0.1, 1.0, float("nan")):
+        with pytest.raises(HandError, match="open_from"):
+            replace(MODELS["mpl"], open_from=bad)
+
+
+def test_the_mpl_is_read_opposed_pre_flexed_and_unbalanced():
+    derived = derive_hand("mpl")
+    assert derived.hand.is_3d and not derived.notes and derived.hand.max_imbalance == 1.0
+    assert dict(derived.mount.held) == {"A_thumb_ABD": pytest.approx(2.1)}  # its ctrlrange's top: opposed
 
 
 def test_our_simulated_hand_is_not_built_from_measured_chains():
@@ -228,3 +246,16 @@ def test_a_model_of_thousands_of_bodies_is_refused_before_it_is_closed(tmp_path)
     path.write_text(f'<mujoco><worldbody><body name="palm"><geom size="0.01"/>{bodies}</body></worldbody></mujoco>')
     with pytest.raises(HandFileError, match="many.xml: 2002 bodies, more than a hand model has"):
         derive_hand(path, fingertips=["b1", "b2"])
+
+
+def test_every_bundled_model_file_and_its_licence_is_installed_with_the_package():
+    import fnmatch
+    import tomllib
+
+    root = Path(__file__).resolve().parents[2]
+    patterns = tomllib.loads((root / "pyproject.toml").read_text())["tool"]["setuptools"]["package-data"]["contourgrasp"]
+    package = root / "src" / "contourgrasp"
+    files = [p.relative_to(package).as_posix() for p in (package / "data" / "models").rglob("*") if p.is_file()
+             and "__pycache__" not in p.parts]
+    assert "data/models/mpl/LICENSE" in files
+    assert [f for f in files if not any(fnmatch.fnmatchcase(f, pattern) for pattern in patterns)] == []

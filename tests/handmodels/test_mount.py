@@ -1,3 +1,5 @@
+import warnings
+
 import numpy as np
 import pytest
 
@@ -21,7 +23,7 @@ def tips_in_hand_frame(scene, name):
     return (scene.data.site_xpos[sites] - position) @ rotation
 
 
-@pytest.mark.parametrize("name", ["jaco-three-finger", "inspire"])
+@pytest.mark.parametrize("name", ["jaco-three-finger", "inspire", "mpl"])
 def test_mounted_model_opens_and_closes_on_its_derived_hand(name):
     mounted = mount_model(name)
     scene = build_scene("can", seed=0, hand=mounted)
@@ -39,6 +41,20 @@ def test_mounted_model_opens_and_closes_on_its_derived_hand(name):
     fit_error = np.array([fit.error for fit in mounted.derivation.fits])
     assert np.all(nearest < np.maximum(1e-3, 2 * fit_error)), (nearest, fit_error)
     assert set(mounted.geom_names()) <= {scene.model.geom(g).name for g in range(scene.model.ngeom)}
+
+
+def test_only_the_palm_s_subtree_is_mounted():
+    """The MPL's palm hangs below its forearm and wrist bodies, which carry collision geoms: those stay out; the scene's
+    settings rule (the model brings no conflicting option)."""
+    mpl = mount_model("mpl")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        scene = build_scene("can", seed=0, hand=mpl)
+    m = scene.model
+    bodies = {m.body(int(m.geom_bodyid[m.geom(name).id])).name.removeprefix(PREFIX) for name in mpl.geom_names()}
+    assert "palm" in bodies and not bodies & {"forearm", "wristx", "wristy", "wristz"}
+    assert len(mpl.geom_names()) == sum(1 for name in mpl.geom_names() if name.split("_")[0] in
+                                        {"palm", "thumb", "index", "middle", "ring", "little"})
 
 
 def test_a_trial_with_the_mounted_jaco_grasps_the_can(jaco):

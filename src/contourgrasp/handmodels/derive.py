@@ -16,7 +16,8 @@ fingertips end farther apart (mean distance from their centroid) than they began
 repeated from the high ends to the low ones. A finger is *closed* where its projected tip is
 farthest from where it was open: a curling finger's tip swings back under the palm at the end,
 which no ray or arc follows and an object in the way never sees. Actuators outside the synergy
-keep control 0, except those a :class:`ModelSpec` holds (a pre-shape).
+keep control 0, except those a :class:`ModelSpec` holds (a pre-shape); its ``open_from`` starts the
+synergy part of the way to closed (a pre-flexed open hand), and the simulation opens the hand as far.
 
 *Frames.* The 3-D hand frame is the palm body's frame with its axes renamed: z (the approach, toward
 the object) is the :class:`ModelSpec`'s ``approach`` axis, or else the palm axis (+-x, +-y or +-z)
@@ -135,12 +136,17 @@ class ModelSpec:
         The derived hand's :attr:`Hand.grasp_height_fraction`, chosen on the bench for the same reason.
     slice_contour : bool or "unbalanced"
         The derived hand's :attr:`Hand.slice_contour`, chosen on the bench for the same reason.
+    open_from : float
+        The synergy's open end as a fraction of the way from its open to its closed controls, in [0, 1):
+        the hand opens only that far, a pre-flexed open hand (0: fully open). For a hand whose fingers,
+        fully open, point along the approach, so that curling they first swing out and up; the
+        simulation opens the hand as far (:attr:`Mount.open_controls`).
 
     Raises
     ------
     HandError
-        A ``max_imbalance`` or ``grasp_height_fraction`` out of range, a ``slice_contour`` not one of
-        :data:`~contourgrasp.hand.SLICE_CONTOUR`.
+        A ``max_imbalance``, ``grasp_height_fraction`` or ``open_from`` out of range, a ``slice_contour`` not
+        one of :data:`~contourgrasp.hand.SLICE_CONTOUR`.
     """
 
     path: str
@@ -154,6 +160,7 @@ class ModelSpec:
     tips_brush_table: bool = False
     grasp_height_fraction: float = tol.GRASP_HEIGHT_FRACTION
     slice_contour: bool | str = "unbalanced"
+    open_from: float = 0.0
 
     def __post_init__(self):
         # Checked as the Hand will check them, but before the model is closed for seconds.
@@ -163,6 +170,9 @@ class ModelSpec:
             "grasp_height_fraction", self.grasp_height_fraction, tol.MAX_GRASP_HEIGHT_FRACTION, error=HandError))
         object.__setattr__(self, "slice_contour",
                            validation.choice("slice_contour", self.slice_contour, SLICE_CONTOUR, error=HandError))
+        object.__setattr__(self, "open_from", validation.bounded("open_from", self.open_from, 1.0, error=HandError))
+        if self.open_from == 1.0:
+            raise HandError("open_from must be below 1 (1 opens the hand not at all)")
 
 
 def _bundled(folder: str, xml: str, fingers, **options) -> ModelSpec:
@@ -171,8 +181,11 @@ def _bundled(folder: str, xml: str, fingers, **options) -> ModelSpec:
 
 
 _INSPIRE_FINGERS = ("thumb", "index", "middle", "ring", "pinky")
+#: The five-finger models' fingers by the names of our hand's.
+_FIVE_FINGER_NAMES = ("thumb", "index", "middle", "ring", "little")
 
-#: The hand models shipped with the package (from robosuite 1.5.2, MIT; data/models/README.md). The
+#: The hand models shipped with the package (the Inspire and the Jaco from robosuite 1.5.2, MIT; the MPL from the
+#: dexterity 0.0.15 wheel, Apache-2.0; data/models/README.md). The
 #: Inspire hand's thumb rotation is its own motor: held opposed (the high end), not part of the synergy; it is read
 #: :data:`LEVEL` (chosen on ycb-train and the thesis's five: docs/hand-models.md, "The bench on the models"). The Jaco's
 #: fingers each hold their own position: its squeeze's balance is off (max_imbalance 1), chosen on its ycb-train
@@ -180,17 +193,23 @@ _INSPIRE_FINGERS = ("thumb", "index", "middle", "ring", "pinky")
 #: (tips_brush_table), the Jaco's do not: chosen on the same trials (docs/hand3d.md, "The 3-D hand in the plan"). The
 #: Inspire's curling fingers are asked for no part of the object's height (grasp_height_fraction 0) and are planned on
 #: the outline seen (slice_contour false): both chosen on its ycb-train trials (docs/hand-models.md, "The bench on the
-#: models").
+#: models"). The MPL's thumb abduction is held at the top of its range (opposed), its synergy starts a fifth of the
+#: way to closed (open_from 0.2: fully open, its fingers point down the approach and their curling tips rise past
+#: the palm's underside) and its squeeze's balance is off: all three chosen on its thesis's-five and ycb-train
+#: trials (docs/studies.md, "The MPL model").
 MODELS = {
     "inspire": _bundled(
         "inspire", "inspire_right_hand.xml", _INSPIRE_FINGERS, palm="r_palm",
-        names=("thumb", "index", "middle", "ring", "little"),
+        names=_FIVE_FINGER_NAMES,
         actuators=tuple(f"{f}_{j}_drive" for f in _INSPIRE_FINGERS[1:] for j in ("proximal", "distal"))
         + ("thumb_proximal_2_drive", "thumb_middle_drive", "thumb_distal_drive"),
         hold=(("thumb_proximal_1_drive", 1.0),), approach=LEVEL, tips_brush_table=True, grasp_height_fraction=0.0,
         slice_contour=False),
     "jaco-three-finger": _bundled("jaco_three_finger", "jaco_three_finger_gripper.xml", ("thumb", "index", "pinky"),
                                   palm="right_gripper", names=("thumb", "index", "pinky"), max_imbalance=1.0),
+    "mpl": _bundled("mpl", "mpl_right.xml", _INSPIRE_FINGERS, palm="palm", names=_FIVE_FINGER_NAMES,
+                    actuators=tuple(f"A_{f}_MCP" for f in _INSPIRE_FINGERS) + ("A_thumb_PIP", "A_thumb_DIP"),
+                    hold=(("A_thumb_ABD", 1.0),), approach=LEVEL, open_from=0.2, max_imbalance=1.0),
 }
 
 
@@ -434,6 +453,9 @@ def simulate_closing(m, spec: ModelSpec, close_time: float, hold_time: float):
     closing = run(acts, lo, hi, held, spec.path)
     if _spread(closing[0][:, -1]) > _spread(closing[0][:, 0]):  # the high ends open the hand: close toward the low
         lo, hi = hi, lo
+        closing = run(acts, lo, hi, held, spec.path)
+    if spec.open_from > 0:  # a pre-shape: the synergy opens only part of the way
+        lo = lo + spec.open_from * (hi - lo)
         closing = run(acts, lo, hi, held, spec.path)
     return run, acts, held, lo, hi, closing
 

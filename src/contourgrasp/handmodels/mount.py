@@ -23,7 +23,7 @@ import numpy as np
 
 from ..sim.tendon_hand import HAND_BIT, TABLE_BIT, HandDesign, base_servos_xml, base_xml
 from .derive import Derivation, derive_hand, model_spec
-from .lookup import load_model
+from .lookup import load_model, subtree
 from ..sim.scene import mujoco
 
 #: Prefix of the mounted model's names in the scene.
@@ -75,12 +75,14 @@ class MountedHand:
 
     @cached_property
     def _geom_plan(self) -> tuple[tuple[int, str], ...]:
-        """(index in the model's geoms, name in the scene) of every collision geom."""
+        """(index in the model's geoms, name in the scene) of every collision geom mounted: on the palm's subtree (a
+        forearm or a wrist above it stays out)."""
         finger_of = dict(self.derivation.mount.finger_bodies)
         m = _named_geoms(self.path).compile()
+        mounted = subtree(m, m.body(self.derivation.mount.palm).id)
         counts, plan = {}, []
         for g in sorted(range(m.ngeom), key=lambda g: int(m.geom(g).name.removeprefix("geom"))):
-            if not (m.geom_contype[g] or m.geom_conaffinity[g]):
+            if not (m.geom_contype[g] or m.geom_conaffinity[g]) or int(m.geom_bodyid[g]) not in mounted:
                 continue
             finger = finger_of.get(m.body(m.geom_bodyid[g]).name)
             owner = "palm" if finger is None else self.fingers[finger].name
