@@ -574,6 +574,9 @@ MODEL_FIT_TOLERANCE = 3e-3
 
 #: A neighbour whose centre of mass rose more than this (m) during a grasp was lifted with the target.
 NEIGHBOUR_LIFT = 0.02
+#: A target that sank more than this (m) from the lift's start to the hold's end left the table: the scene has no
+#: floor, so it fell for the seconds of the lift and hold (the trials' figure says so rather than a depth).
+FELL_OFF_TABLE = 0.5
 
 #: The bench (sim.bench.Bench): trials per object and planner, trials in all (objects x trials x planners; at about a
 #: second a trial per core, a day's work on a small cluster), and the largest first seed (numpy's seeds are unbounded;

@@ -11,7 +11,7 @@ from matplotlib.figure import Figure
 
 import contourgrasp.sim.bench as bench_package
 from contourgrasp.sim.bench import Bench, BenchTrial, thesis_objects
-from contourgrasp.sim.bench.figures import failures_figure, objects_figure, success_figure, trials_figure
+from contourgrasp.sim.bench.figures import _outcome, failures_figure, objects_figure, success_figure, trials_figure
 from contourgrasp.sim.trial import TrialRecord
 
 MODULES = ("config", "parallel", "run", "stats", "report", "journal", "figures")
@@ -35,6 +35,15 @@ def test_split_figures_are_drawn_from_results():
     figure = objects_figure(bench, results)
     assert [ax.get_title().split(" (")[0] for ax in figure.axes] == ["train", "other"]
     assert isinstance(failures_figure(bench, []), Figure)
+
+
+@pytest.mark.parametrize("lift, said", [(0.12, "lifted 12.0 cm, moved 3 mm in the hand"),
+                                         (-0.004, "lifted -0.4 cm, moved 3 mm in the hand"),
+                                         (-31.1, "knocked off the table")])
+def test_a_trial_s_outcome_says_how_far_the_object_rose_or_that_it_left_the_table(lift, said):
+    record = TrialRecord(object="can", success=False, cause="object pushed away before all fingers touched",
+                         **{**RECORD, "lift": lift, "hold_drift": 0.003, "fingers_in_contact": ("thumb",)})
+    assert _outcome(record) == f"failed: pushed; {said}; touching: thumb"
 
 
 def _bench_imports(module: str) -> set[str]:

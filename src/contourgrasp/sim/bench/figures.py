@@ -11,6 +11,7 @@ from matplotlib.figure import Figure
 
 from ...hand import to_image
 from ...pipeline import plan_to_camera
+from ...tolerances import FELL_OFF_TABLE
 from ...visualize import FINGER_COLOURS
 from .config import SHORT_CAUSES, Bench, label
 from .stats import records, sort_planner, success_rates, thesis_rates, wilson_interval
@@ -155,8 +156,9 @@ def _outcome(record) -> str:
         last = "" if record.cause is None else f"; last: {SHORT_CAUSES[record.cause]}"
         return f"cleared {record.cleared}/{record.scene_objects}: {record.ended}{last}"
     outcome = "held" if record.success else f"failed: {SHORT_CAUSES[record.cause]}"
-    return (f"{outcome}; lifted {100 * record.lift:.1f} cm, moved {1000 * record.hold_drift:.0f} mm in the hand; "
-            f"touching: {', '.join(record.fingers_in_contact) or 'none'}")
+    moved = ("knocked off the table" if record.lift < -FELL_OFF_TABLE else
+             f"lifted {100 * record.lift:.1f} cm, moved {1000 * record.hold_drift:.0f} mm in the hand")
+    return f"{outcome}; {moved}; touching: {', '.join(record.fingers_in_contact) or 'none'}"
 
 
 def draw_side_panel(ax, snap) -> None:
