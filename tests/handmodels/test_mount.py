@@ -9,7 +9,7 @@ from contourgrasp.handmodels.mount import PREFIX, mount_model
 from contourgrasp.sim.objects import soda_can
 from contourgrasp.sim.planners import make_planner
 from contourgrasp.sim.scene import build_scene
-from contourgrasp.sim.trial import STRUCK, Execution, execute_grasp, pose_matrix, run_trial
+from contourgrasp.sim.trial import HIT, STRUCK, Execution, execute_grasp, pose_matrix, run_trial
 
 
 @pytest.fixture(scope="module")
@@ -62,6 +62,15 @@ def test_a_trial_with_the_mounted_jaco_grasps_the_can(jaco):
     planner = make_planner("default", jaco.hand, seed=0)
     record = run_trial("can", seed=0, planner=planner, hand=jaco)
     assert record.cause is None and set(record.fingers_in_contact) == {"thumb", "index", "pinky"}
+
+
+def test_a_mounted_model_grasps_among_neighbours(jaco):
+    """A clutter scene simulates the mounted model as a single object's scene does (it was refused, read as a file)."""
+    planner = make_planner("default", jaco.hand, seed=0)
+    records = [run_trial("can", seed=seed, planner=planner, hand=jaco, scene_kind="clutter", pool=("bottle", "case"))
+               for seed in (0, 1)]
+    assert [r.cause for r in records] == [HIT, None]  # seed 0's hand touches a neighbour: a failure, not a refusal
+    assert set(records[1].fingers_in_contact) == {"thumb", "index", "pinky"}
 
 
 def test_the_inspire_palm_below_its_frame_is_kept_clear_of_a_tall_object():

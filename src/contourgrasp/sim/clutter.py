@@ -51,13 +51,12 @@ import numpy as np
 from ..errors import SimulationError
 from ..perception import deepest_pixel
 from ..hand import Hand
-from ..io.hand_file import load_hand
 from ..validation import choice
-from .tendon_hand import HandDesign, build_hand
+from .tendon_hand import HandDesign
 from .objects import ObjectSpec, object_spec
 from .render import tilted_view, truth_labels
 from .mjcf import Bin, Placement, scene_xml
-from .scene import PARK_HEIGHT, Camera, Scene, Workspace, mujoco, mujoco_warnings
+from .scene import PARK_HEIGHT, Camera, Scene, Workspace, compile_scene, mujoco, mujoco_warnings, simulated_hand
 
 #: The scenes a trial can take place in.
 SCENE_KINDS = ("single", "clutter", "bin")
@@ -215,7 +214,7 @@ def build_clutter(obj, pool, *, kind: str, seed: int, hand: Hand | str = "five-f
     seed : int
         Chooses everything (:func:`arrange`); same seed, same scene.
     hand, design, timing, camera, workspace
-        As :func:`~contourgrasp.sim.scene.build_scene`; ``camera`` is the top-down
+        As :func:`~contourgrasp.sim.scene.build_scene` (a mounted hand model too); ``camera`` is the top-down
         reference the grasp is executed in, and its height the tilted camera's distance.
     settle : float
         Seconds the objects settle before anything looks at them, and longer while they still move
@@ -225,10 +224,10 @@ def build_clutter(obj, pool, *, kind: str, seed: int, hand: Hand | str = "five-f
     """
     obj = object_spec(obj)
     layout = arrange(kind, obj, [object_spec(o) for o in pool], seed=seed, workspace=workspace)
-    hand_model = build_hand(load_hand(hand), design=design, timing=timing)
+    hand_model = simulated_hand(hand, design=design, timing=timing)
     with mujoco_warnings():
-        model = mujoco.MjModel.from_xml_string(scene_xml(obj, hand_model, layout.target,
-                                                         neighbours=layout.neighbours, bin=layout.bin, robot=robot))
+        model = compile_scene(scene_xml(obj, hand_model, layout.target, neighbours=layout.neighbours, bin=layout.bin,
+                                        robot=robot), hand_model)
         data = mujoco.MjData(model)
     scene = Scene(model, data, obj, hand_model, camera, layout.target, kind=kind,
                   neighbours=tuple(o for o, _ in layout.neighbours), bin=layout.bin,

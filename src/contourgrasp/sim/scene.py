@@ -469,13 +469,13 @@ def build_scene(obj, *, seed: int, hand: Hand | str = "five-finger-linear", desi
         A robot arm in view (:data:`~contourgrasp.sim.mjcf.ROBOT_ARM`).
     """
     obj = object_spec(obj)
-    hand_model = hand if hasattr(hand, "mount") else build_hand(load_hand(hand), design=design, timing=timing)
+    hand_model = simulated_hand(hand, design=design, timing=timing)
     rng = np.random.default_rng(np.random.SeedSequence([seed, 0]))
     placement = Placement(x=float(rng.uniform(-workspace.half_x, workspace.half_x)),
                           y=float(rng.uniform(-workspace.half_y, workspace.half_y)),
                           yaw=float(rng.uniform(0.0, 2 * np.pi)))
     with mujoco_warnings():
-        model = _compile(scene_xml(obj, hand_model, placement, robot=robot), hand_model)
+        model = compile_scene(scene_xml(obj, hand_model, placement, robot=robot), hand_model)
         data = mujoco.MjData(model)
     scene = Scene(model, data, obj, hand_model, camera, placement)
     scene.set_hand(0.0, 0.0, PARK_HEIGHT, 0.0)
@@ -483,8 +483,15 @@ def build_scene(obj, *, seed: int, hand: Hand | str = "five-finger-linear", desi
     return scene
 
 
-def _compile(xml: str, hand) -> mujoco.MjModel:
-    """The scene's model; a mounted hand model is attached to the parsed scene before compiling."""
+def simulated_hand(hand, *, design: HandDesign = HandDesign(), timing: str = "thesis"):
+    """The hand a scene simulates: a mounted hand model (:class:`~contourgrasp.handmodels.mount.MountedHand`) as
+    itself, else our tendon hand built from ``hand`` (a preset name, a hand TOML path or a :class:`Hand`)."""
+    return hand if hasattr(hand, "mount") else build_hand(load_hand(hand), design=design, timing=timing)
+
+
+def compile_scene(xml: str, hand) -> mujoco.MjModel:
+    """The scene's model from its MJCF and :func:`simulated_hand`: a mounted hand model is attached to the parsed
+    scene before compiling."""
     if not hasattr(hand, "mount"):
         return mujoco.MjModel.from_xml_string(xml)
     spec = mujoco.MjSpec.from_string(xml)
