@@ -24,7 +24,10 @@ onto the depth grid) and planned with the default planner and hand (``--planner 
 
 Usage::
 
-    python benchmarks/real_frames.py [--data PATH] [--runs 3] [--clock cpu|wall]
+    python benchmarks/real_frames.py [--data PATH] [--runs 3] [--clock cpu|wall] [--any]
+
+``--any`` plans with :func:`contourgrasp.pipeline.plan_any` (``plan --any``): where the object chosen has no
+feasible grasp, the next one.
 
 ``--data`` defaults to ``$CONTOURGRASP_SHARED_DATA`` or ``../shared/data`` beside the repository.
 The frames are the project's shared data, not its training data: nothing was tuned on their figures.
@@ -51,7 +54,7 @@ import numpy as np  # noqa: E402
 from contourgrasp import load_hand, load_planner, perception  # noqa: E402
 from contourgrasp.errors import ContourGraspError, NoFeasibleGrasp  # noqa: E402
 from contourgrasp.io.camera_file import frame_files, read_rgbd  # noqa: E402
-from contourgrasp.pipeline import plan_frame  # noqa: E402
+from contourgrasp.pipeline import plan_any, plan_frame  # noqa: E402
 
 SHARED_DATA = Path(os.environ.get("CONTOURGRASP_SHARED_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
 #: A target is one object when at least this share of its pixels lies on one label.
@@ -106,25 +109,25 @@ def iou(a, b) -> float:
     return float((a & b).sum() / max((a | b).sum(), 1))
 
 
-def plan_once(rgb, depth, intrinsics, hand, options):
-    """(plan or None, reason) of one call of ``plan_frame``."""
+def plan_once(rgb, depth, intrinsics, hand, options, plan=plan_frame):
+    """(plan or None, reason) of one call of ``plan`` (``plan_frame``, or ``plan_any``)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
-            return plan_frame(rgb, depth, intrinsics, hand, options), ""
+            return plan(rgb, depth, intrinsics, hand, options), ""
         except NoFeasibleGrasp as err:
             return None, f"no feasible grasp: {err.reason}"
         except ContourGraspError as err:
             return None, f"refused: {err}"
 
 
-def run(folder: Path, hand, options, runs: int, clock) -> tuple[str, ...]:
+def run(folder: Path, hand, options, runs: int, clock, plan=plan_frame) -> tuple[str, ...]:
     rgb, depth, intrinsics = frame(folder)
-    result, reason = plan_once(rgb, depth, intrinsics, hand, options)  # warm-up, and the result
+    result, reason = plan_once(rgb, depth, intrinsics, hand, options, plan)  # warm-up, and the result
     times = []
     for _ in range(runs):
         start = clock()
-        plan_once(rgb, depth, intrinsics, hand, options)
+        plan_once(rgb, depth, intrinsics, hand, options, plan)
         times.append(1000 * (clock() - start))
     if result is None:
         outcome, seen = reason[:160], None
@@ -142,6 +145,8 @@ def main(argv=None) -> int:
     parser.add_argument("--data", type=Path, default=SHARED_DATA, help="shared data folder")
     parser.add_argument("--runs", type=int, default=3, help="timed runs per frame; the median is reported")
     parser.add_argument("--clock", choices=("cpu", "wall"), default="cpu", help="CPU time of the process, or wall time")
+    parser.add_argument("--any", action="store_true",
+                        help="plan_any (plan --any): the next object when the one chosen has no feasible grasp")
     args = parser.parse_args(argv)
     folders = sorted(p for p in (args.data / "rgbd").glob("real_*") if p.is_dir())
     if not folders:
@@ -153,7 +158,8 @@ def main(argv=None) -> int:
     print("| frame | depth size | tilt (deg) | outcome | the target against the truth | warm time (ms) |")
     print("|---|---|---:|---|---|---:|")
     for folder in folders:
-        print("| " + " | ".join(run(folder, hand, options, args.runs, clock)) + " |", flush=True)
+        print("| " + " | ".join(run(folder, hand, options, args.runs, clock, plan_any if args.any else plan_frame))
+              + " |", flush=True)
     return 0
 
 

@@ -680,3 +680,52 @@ def test_the_phoxi_frames_colour_at_twice_its_depth_is_read_with_its_own_intrins
     on_depth = cg.perception.colour_on_depth(frame.rgb, frame.depth.shape, intrinsics=frame.intrinsics,
                                              colour_intrinsics=frame.colour_intrinsics)
     assert on_depth.shape == (386, 516, 3)
+
+
+# --- plan_any: some object of a scene of several ---
+
+@pytest.fixture(scope="module")
+def clutter_frame():
+    from contourgrasp.sim import build_clutter, render
+
+    scene = build_clutter("can", ("can-standing", "case"), kind="clutter", seed=1)
+    rgb, depth = render(scene, sensor="structured-light", seed=1)
+    return rgb, depth, scene.camera.intrinsics
+
+
+def test_plan_any_plans_the_object_it_chooses_itself_first(clutter_frame):
+    hand, options = cg.load_hand("five-finger-linear"), cg.load_planner("default").options
+    chosen = pipeline.plan_frame(*clutter_frame, hand, options)
+    anyone = pipeline.plan_any(*clutter_frame, hand, options)
+    assert anyone.target.label == chosen.target.label and np.array_equal(anyone.plan.pose, chosen.plan.pose)
+
+
+def test_plan_any_tries_the_objects_a_grasp_failed_on_last(clutter_frame):
+    from contourgrasp.errors import PlannerError
+    from contourgrasp.perception import hand_opening
+    from contourgrasp.synthesis import SceneMemory
+
+    hand, options = cg.load_hand("five-finger-linear"), cg.load_planner("default").options
+    first = pipeline.plan_frame(*clutter_frame, hand, options)
+    memory = SceneMemory().with_failure(first.seen, first.metric.contour_xy, first.plan.pose)
+    support = pipeline.find_objects(clutter_frame[1], clutter_frame[2], rgb=clutter_frame[0])
+    order = pipeline.objects_to_try(support.candidates, hand, memory)
+    assert len(order) >= 2 and (order[-1].mask & first.seen).any() and not (order[0].mask & first.seen).any()
+    assert all(c.in_view and c.extent[1] <= hand_opening(hand) for c in order)
+    again = pipeline.plan_any(*clutter_frame, hand, options, memory=memory)
+    assert again.target.label != first.target.label and not (again.seen & first.seen).any()
+    with pytest.raises(PlannerError, match="plan_any's memory must be a SceneMemory, got GraspMemory"):
+        pipeline.plan_any(*clutter_frame, hand, options, memory=memory.of(first.seen))
+
+
+@needs_shared
+def test_plan_any_plans_the_phoxi_bin_whose_chosen_object_has_no_grasp():
+    """The real PhoXi bin: every pose on the object the hand rule chooses strikes the wall or a neighbour; another
+    object has a plan."""
+    folder = SHARED / "rgbd" / "real_gqcnn_phoxi_fcgqcnn_2"
+    frame = read_rgbd(folder / "color.png", folder / "depth.npy", folder / "camera.yaml")
+    hand, options = cg.load_hand("five-finger-linear"), cg.load_planner("default").options
+    with pytest.raises(cg.NoFeasibleGrasp, match="bin wall"):
+        pipeline.plan_frame(frame.rgb, frame.depth, frame.intrinsics, hand, options)
+    result = pipeline.plan_any(frame.rgb, frame.depth, frame.intrinsics, hand, options)
+    assert result.target is not None and result.target.in_view

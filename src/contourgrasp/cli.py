@@ -156,6 +156,9 @@ def _parser() -> argparse.ArgumentParser:
                              "the image centre)")
     target.add_argument("--roi", type=_roi, metavar="X,Y,W,H",
                         help="plan on the wholly visible object with most pixels in this box")
+    target.add_argument("--any", action="store_true",
+                        help="plan on the object it chooses, or when that has no feasible grasp on the next wholly "
+                             "visible object the hand spans, until one plans (at most 6 more; a bin, a table to clear)")
     target.add_argument("--all", action="store_true",
                         help="plan every wholly visible object: --out PLAN.json writes PLAN_<label>.json per "
                              "object planned (--plot PLAN.png: PLAN_<label>.png), all or none; without --out the "
@@ -465,7 +468,7 @@ def _read_frame(args):
 def _plan(args) -> int:
     from .io.camera_file import read_extrinsics
     from .io.plan_file import image_plan_to_dict
-    from .pipeline import plan_frame
+    from .pipeline import plan_any, plan_frame
 
     frame = _bag_frame(args) if args.bag else _read_frame(args)
     if frame.depth is None:
@@ -475,8 +478,14 @@ def _plan(args) -> int:
     extrinsics = None if args.extrinsics is None else read_extrinsics(args.extrinsics)
     if args.all:
         return _plan_all(args, frame, options, extrinsics)
-    result = plan_frame(frame.rgb, frame.depth, frame.intrinsics, load_hand(args.hand), options, mask=frame.mask,
-                        target_px=args.target, roi=args.roi, T_base_camera=extrinsics)
+    if args.any:
+        if frame.mask is not None or options.perception.segment == "rgb":
+            raise InputError("--any chooses among the depth candidates: not with --mask or --segment rgb")
+        result = plan_any(frame.rgb, frame.depth, frame.intrinsics, load_hand(args.hand), options,
+                          T_base_camera=extrinsics)
+    else:
+        result = plan_frame(frame.rgb, frame.depth, frame.intrinsics, load_hand(args.hand), options,
+                            mask=frame.mask, target_px=args.target, roi=args.roi, T_base_camera=extrinsics)
 
     def figure():
         from .visualize import image_plan_figure

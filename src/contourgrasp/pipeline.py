@@ -466,6 +466,72 @@ def palm_depth(metric: MetricContour, heights: HeightMap, hand: Hand, pose, tip_
     return float(z + metric.R_camera_plane[:, 2] @ metric.origin)
 
 
+def plan_any(rgb, depth, intrinsics: Intrinsics, hand: Hand, options: PlanOptions = PlanOptions(), *,
+             memory: SceneMemory | None = None, T_base_camera=None, colour_intrinsics: Intrinsics | None = None
+             ) -> ImageGraspPlan:
+    """A plan on some object of a scene of several: the one :func:`plan_frame` chooses, or when it has none, the next.
+
+    Our reading of "grasp something" (a bin, a table to clear): first the object :func:`plan_frame` chooses
+    itself, unless a grasp already failed in this scene (``memory`` has an object); then, or when that
+    object has no feasible grasp, each other of :func:`objects_to_try` in turn -- those with the fewest failed
+    grasps first -- planned at the pixel deepest inside it, until one has a plan. The result's ``target``
+    and ``seen`` say which object it is on. The parameters are :func:`plan_frame`'s; ``memory`` a
+    :class:`~contourgrasp.synthesis.SceneMemory` (each object planned with its own failures).
+
+    Raises
+    ------
+    NoFeasibleGrasp
+        No object tried has a plan; the reason names how many were tried, and the last one's reason.
+    InputError
+        As :func:`plan_frame`, for the frame and the options.
+    """
+    if memory is not None and not isinstance(memory, SceneMemory):
+        raise PlannerError(f"plan_any's memory must be a SceneMemory, got {type(memory).__name__}")
+    frame = dict(T_base_camera=T_base_camera, colour_intrinsics=colour_intrinsics, memory=memory)
+    reason, tried = None, 0
+    if memory is None or not memory.objects:
+        try:
+            return plan_frame(rgb, depth, intrinsics, hand, options, **frame)
+        except NoFeasibleGrasp as err:
+            reason, tried = err.reason, 1
+    perceive = options.perception
+    found = find_objects(depth, intrinsics, rgb=_on_depth_grid(rgb, np.shape(depth)[:2], intrinsics, colour_intrinsics),
+                         fill_holes=perceive.fill_holes, colour_offset_px=perceive.colour_offset_px)
+    own = perception.choose_target(found.candidates, max_width=perception.hand_opening(hand))[0] if tried else None
+    for candidate in objects_to_try(found.candidates, hand, memory):
+        if own is not None and candidate.label == own.label:  # planned on already, the first time
+            continue
+        tried += 1
+        try:
+            return plan_frame(rgb, depth, intrinsics, hand, options, target_px=perception.deepest_pixel(candidate.mask),
+                              **frame)
+        except (NoFeasibleGrasp, SegmentationError) as err:
+            reason = getattr(err, "reason", str(err))
+    if reason is None:
+        raise NoFeasibleGrasp("no object standing wholly in view is narrow enough for the hand to span")
+    raise NoFeasibleGrasp(f"none of the {tried} objects tried has a feasible grasp; the last: {reason}")
+
+
+def _on_depth_grid(rgb, shape, intrinsics: Intrinsics, colour_intrinsics: Intrinsics | None):
+    """``rgb`` on the depth image's grid of ``shape`` (:func:`contourgrasp.perception.colour_on_depth`); None stays None."""
+    if rgb is None:
+        return None
+    return perception.colour_on_depth(rgb, shape, intrinsics=None if colour_intrinsics is None else intrinsics,
+                                      colour_intrinsics=colour_intrinsics)
+
+
+def objects_to_try(candidates, hand: Hand, memory: SceneMemory | None = None) -> list[perception.Candidate]:
+    """The objects :func:`plan_any` tries after its own choice: the candidates standing wholly in view whose
+    minimum-area rectangle is no wider than the hand opens (:func:`~contourgrasp.perception.hand_opening`), the
+    first ``tolerances.MAX_OBJECTS_TRIED`` of them in :func:`find_objects`' order, those with the fewest failed
+    grasps in ``memory`` first."""
+    width = perception.hand_opening(hand)
+    spanned = [c for c in candidates if c.in_view and c.extent[1] <= width][:tol.MAX_OBJECTS_TRIED]
+    if memory is None:
+        return spanned
+    return sorted(spanned, key=lambda c: len(memory.of(c.mask)))
+
+
 def find_objects(depth, intrinsics: Intrinsics, *, rgb=None, fill_holes: bool = True,
                  colour_offset_px=None) -> perception.Support:
     """The support surface and every candidate on it, as :func:`plan_frame` finds them (``plan --all``).
@@ -542,9 +608,7 @@ def _perceive(rgb, depth, intrinsics, options: PerceptionOptions, *, mask, targe
         raise PerceptionError("target_px and roi choose among the depth candidates: not with a mask or segment='rgb'")
     d = perception.as_depth(depth)
     intrinsics.check_shape(d.shape, "depth image")
-    if rgb is not None:
-        rgb = perception.colour_on_depth(rgb, d.shape, intrinsics=None if colour_intrinsics is None else intrinsics,
-                                         colour_intrinsics=colour_intrinsics)
+    rgb = _on_depth_grid(rgb, d.shape, intrinsics, colour_intrinsics)
     if not perception.valid_depth(d).any():
         raise PerceptionError("the depth image has no valid reading (all 0, NaN or outside the sensor range)")
     filled = 0

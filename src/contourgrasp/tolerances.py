@@ -144,6 +144,8 @@ MIN_TABLE_HOLE_PX = 20
 MAX_PROCEDURAL_OBJECTS = 1000
 #: ``plan --all`` plans at most this many objects (bounds the work a cluttered frame can ask for).
 MAX_ALL_OBJECTS = 16
+#: ``plan_any`` (and a clearing run) tries at most this many objects when its own choice has no plan.
+MAX_OBJECTS_TRIED = 6
 
 #: Smallest object, in pixels (about 2 x 2 cm at 0.7 m with a 525 px focal length).
 MIN_AREA_PX = 200

@@ -310,7 +310,26 @@ def test_cli_plan_all_skips_an_object_without_a_grasp_and_exits_3_when_none_has_
     assert "none of the 1 wholly visible objects was planned" in capsys.readouterr().err
 
 
+def test_cli_plan_any_plans_the_next_object_when_the_chosen_one_has_none(tmp_path, capsys):
+    import json
+
+    middle, far = (300, 220, 40, 40, 0.06), (560, 40, 40, 40, 0.06)
+    walls = [(150, 150, 148, 180, 0.25), (342, 150, 148, 180, 0.25)]  # 25 cm tall, 2 px from it
+    args = _scene_files(tmp_path, middle, *walls, far)
+    assert main([*args, "--out", str(tmp_path / "plan.json")]) == 3  # the one nearest the centre, between the walls
+    assert not (tmp_path / "plan.json").exists()
+    assert main([*args, "--any", "--out", str(tmp_path / "plan.json")]) == 0
+    target = json.loads((tmp_path / "plan.json").read_text())["target"]
+    assert target["reason"] == "the candidate under pixel (579, 59)"  # the far box's deepest pixel
+    (tmp_path / "walled").mkdir()
+    walled = _scene_files(tmp_path / "walled", middle, *walls)
+    capsys.readouterr()
+    assert main([*walled, "--any", "--out", str(tmp_path / "walled" / "plan.json")]) == 3
+    assert "none of the 3 objects tried has a feasible grasp; the last:" in capsys.readouterr().err  # the walls too
+
+
 @pytest.mark.parametrize(("boxes", "extra", "message"), [
+    ((A,), ["--any", "--segment", "rgb"], "--any chooses among the depth candidates"),
     ((C, (600, 0, 40, 40, 0.05)), ["--all"], "not completely visible: every region on the support surface"),
     ((C, (600, 0, 40, 40, 0.05)), [], "not completely visible"),
     ((), ["--all"], "nothing stands on the support surface"),

@@ -480,3 +480,35 @@ def test_a_failure_reported_is_avoided_by_the_next_plan_and_a_success_or_a_clear
         assert json.loads(camera.call().message)["pose"] == first["pose"]  # forgotten: the first plan again
     finally:
         _stopped(ros, node, camera)
+
+
+def walled_frame():
+    """A top-down frame (0.7 m to the table): a 40 px box between two 25 cm walls 2 px away, no grasp on it,
+    and a free box in a corner; grey colour. (colour, depth, info) messages."""
+    from contourgrasp.perception import Intrinsics
+
+    depth = np.full((480, 640), 0.7, dtype=np.float32)
+    for x, y, w, h, height in ((300, 220, 40, 40, 0.06), (150, 150, 148, 180, 0.25), (342, 150, 148, 180, 0.25),
+                               (560, 40, 40, 40, 0.06)):
+        depth[y:y + h, x:x + w] = 0.7 - height
+    stamp = next(STAMPS) + 0.25
+    intrinsics = Intrinsics(fx=525.0, fy=525.0, cx=319.5, cy=239.5, width=640, height=480)
+    grey = np.full((480, 640, 3), 128, dtype=np.uint8)
+    return image(grey, "rgb8", stamp), image(depth, "32FC1", stamp), camera_info(intrinsics)
+
+
+def test_any_object_plans_the_next_object_where_the_one_chosen_has_no_grasp(ros):
+    fast = dict(hand="three-finger", segment="depth", xy_step=0.03, yaw_step_deg=6.0)
+    for namespace, any_object in (("/first", False), ("/any", True)):
+        node, camera = _started(ros, namespace, any_object=any_object, **fast)
+        try:
+            colour, depth, info = walled_frame()
+            camera.send(node, colour, depth, info)
+            response = camera.call()
+            if not any_object:
+                assert not response.success and response.message.startswith("no feasible grasp")
+                continue
+            assert response.success, response.message
+            assert json.loads(response.message)["target"]["reason"] == "the candidate under pixel (579, 59)"
+        finally:
+            _stopped(ros, node, camera)

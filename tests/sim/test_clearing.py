@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 
 from contourgrasp import load_hand
+from contourgrasp.tolerances import MAX_OBJECTS_TRIED
 from contourgrasp.errors import NoFeasibleGrasp, SimulationError
 from contourgrasp.sim import HIT, MISSED, NO_PLAN, build_clutter, render, run_clearing, truth_labels
-from contourgrasp.sim.clearing import CLEARED, FAILED_IN_A_ROW, FAILURES_IN_A_ROW, MAX_CANDIDATES, NOTHING_PLANNED
+from contourgrasp.sim.clearing import CLEARED, FAILED_IN_A_ROW, FAILURES_IN_A_ROW, NOTHING_PLANNED
 from contourgrasp.perception import hand_opening
 from contourgrasp.pipeline import find_objects
 from contourgrasp.sim.planners import make_planner
@@ -77,7 +78,7 @@ def test_with_no_plan_every_object_the_hand_spans_is_asked_about_then_the_run_en
     assert record.ended == NOTHING_PLANNED and record.outcomes == () and record.cleared == 0
     assert record.plan_error == "no plan here" and record.pose is None and record.cause == NO_PLAN
     first, *others = [pixel for pixel, *_ in planner.asked]
-    assert first is None and 1 <= len(others) <= MAX_CANDIDATES and len(set(others)) == len(others)
+    assert first is None and 1 <= len(others) <= MAX_OBJECTS_TRIED and len(set(others)) == len(others)
     _, rgb, depth, intrinsics = planner.asked[0]
     candidates = find_objects(depth, intrinsics, rgb=rgb).candidates
     assert kind == "clutter" or any(c.in_view and c.extent[1] > hand_opening(HAND) for c in candidates)  # the walls

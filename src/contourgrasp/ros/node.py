@@ -49,7 +49,7 @@ from ..hand import Hand
 from ..io.hand_file import load_hand
 from ..io.plan_file import image_plan_to_dict
 from ..io.planner_file import Planner, load_planner
-from ..pipeline import PlanOptions, approaches_supported, plan_frame
+from ..pipeline import PlanOptions, approaches_supported, plan_any, plan_frame
 from ..synthesis import SceneMemory
 from ..threads import one_blas_thread
 from ..validation import with_options
@@ -80,6 +80,8 @@ PARAMETERS = {
     "approaches": ("", "approach kinds chosen among, joined by '+': top, side, tilted; empty: the planner's"),
     "top_k": (DEFAULTS.search.top_k, "ranked distinct poses in the plan JSON"),
     "target": ([-1, -1], "pixel [u, v] of the depth image: plan on the object under it; [-1, -1]: the default rule"),
+    "any_object": (False, "with no target: where the object chosen has no feasible grasp, plan on the next one the "
+                          "hand spans (a bin, a table to clear; those a grasp failed on last)"),
 }
 
 #: Parameters that may be set while the node runs (checked by ``target_pixel`` when set).
@@ -90,7 +92,8 @@ NO_TARGET = (-1, -1)
 @dataclass(frozen=True)
 class Settings:
     """The node's validated parameters: the hand, the planner, the options planned with (the planner's, with the
-    node's parameters put in) and the target pixel (None: the default rule)."""
+    node's parameters put in), the target pixel (None: the default rule) and whether, without one, the next object
+    is planned where the one chosen has no feasible grasp (:func:`~contourgrasp.pipeline.plan_any`)."""
 
     hand: Hand
     planner: Planner
@@ -98,6 +101,7 @@ class Settings:
     continuous: bool
     options: PlanOptions = DEFAULTS
     target_px: tuple[int, int] | None = None
+    any_object: bool = False
 
 
 def settings_from_parameters(values: dict) -> Settings:
@@ -127,7 +131,8 @@ def settings_from_parameters(values: dict) -> Settings:
         raise InputError(f"parameters {', '.join(PARAMETER_OF.get(n, n) for n in given)} together: {err}") from None
     _require(approaches_supported(hand, options.scene), "approaches",
              "side and tilted approaches need a planner with descent and a 3-D hand", v)
-    return Settings(hand, planner, v["pair_tolerance"], v["continuous"], options, target_pixel(v["target"]))
+    return Settings(hand, planner, v["pair_tolerance"], v["continuous"], options, target_pixel(v["target"]),
+                    v["any_object"])
 
 
 #: The parameter that sets an option, where their names differ.
@@ -318,8 +323,11 @@ class ContourGraspNode(Node):
         with warnings.catch_warnings(record=True) as caught, one_blas_thread():
             warnings.simplefilter("always")
             rgb, d, intrinsics = messages.rgbd_arrays(colour, depth, self.camera_info)
-            result = plan_frame(rgb, d, intrinsics, self.settings.hand, self.settings.options,
-                                target_px=self.settings.target_px, memory=self.memory)
+            if self.settings.any_object and self.settings.target_px is None:
+                result = plan_any(rgb, d, intrinsics, self.settings.hand, self.settings.options, memory=self.memory)
+            else:
+                result = plan_frame(rgb, d, intrinsics, self.settings.hand, self.settings.options,
+                                    target_px=self.settings.target_px, memory=self.memory)
         for w in caught:
             self.get_logger().warning(str(w.message))
         return result

@@ -8,10 +8,10 @@ failed, at most :data:`ATTEMPTS_PER_OBJECT` attempts per object in the scene. Ea
 2. the planner chooses the object itself, as a user's camera frame with no click does (the
    perception's ``"hand"`` rule). After a grasp failed, and whenever the planner's own choice has no
    plan, it is asked about every object standing wholly in view that the hand spans (its minimum-area
-   rectangle no wider than the hand opens: :func:`~contourgrasp.perception.hand_opening`;
-   :func:`~contourgrasp.pipeline.find_objects`, at most :data:`MAX_CANDIDATES`, each at the pixel deepest
-   inside it), those no grasp failed on first, then those with the fewest failures, until one has a
-   plan; each object is planned with the memory of the grasps that failed on it
+   rectangle no wider than the hand opens: :func:`~contourgrasp.pipeline.objects_to_try`, at most
+   ``tolerances.MAX_OBJECTS_TRIED``, each at the pixel deepest inside it), those no grasp failed on first,
+   then those with the fewest failures, until one has a plan (the order :func:`~contourgrasp.pipeline.plan_any`
+   tries them in); each object is planned with the memory of the grasps that failed on it
    (:class:`~contourgrasp.synthesis.SceneMemory`: an object is the one a failure was on when it stands within
    ``tolerances.MEMORY_SAME_OBJECT_PX`` of where that failure's object stood).
    Nothing planned ends the run;
@@ -47,7 +47,7 @@ import warnings
 
 import numpy as np
 
-from .. import perception, pipeline
+from .. import pipeline
 from ..perception import deepest_pixel
 from ..errors import ContourGraspWarning, InputError, NoFeasibleGrasp, SimulationError
 from ..hand import Hand
@@ -64,8 +64,6 @@ from .trial import (HIT, NO_PLAN, NO_PLAN_FIELDS, PARKED, SETTLE_AFTER_FAILURE, 
 FAILURES_IN_A_ROW = 2
 #: At most this many attempts per object in the scene.
 ATTEMPTS_PER_OBJECT = 3
-#: At most this many objects are asked about when the planner's own choice has no plan.
-MAX_CANDIDATES = 6
 #: How a clearing run ended (:attr:`TrialRecord.ended`).
 CLEARED, NOTHING_PLANNED, FAILED_IN_A_ROW, ATTEMPT_LIMIT = ("table cleared", "nothing to plan on",
                                                             "failed twice in a row", "attempt limit")
@@ -164,11 +162,10 @@ def _plan_next(planner, rgb, depth, intrinsics, memory: SceneMemory):
             candidates = pipeline.find_objects(depth, intrinsics, rgb=rgb).candidates
         except InputError as err:
             return None, str(err), time.perf_counter() - started
-        width = perception.hand_opening(planner.hand)
-        spanned = [c for c in candidates if c.in_view and c.extent[1] <= width][:MAX_CANDIDATES]
-        for candidate, own in sorted(((c, memory.of(c.mask)) for c in spanned), key=lambda c: len(c[1])):
+        for candidate in pipeline.objects_to_try(candidates, planner.hand, memory):
             try:
-                planned = planner.plan(rgb, depth, intrinsics, memory=own, target_px=deepest_pixel(candidate.mask))
+                planned = planner.plan(rgb, depth, intrinsics, memory=memory.of(candidate.mask),
+                                       target_px=deepest_pixel(candidate.mask))
                 return planned, None, time.perf_counter() - started
             except (NoFeasibleGrasp, InputError) as err:
                 error = str(err)
