@@ -729,3 +729,11 @@ def test_plan_any_plans_the_phoxi_bin_whose_chosen_object_has_no_grasp():
         pipeline.plan_frame(frame.rgb, frame.depth, frame.intrinsics, hand, options)
     result = pipeline.plan_any(frame.rgb, frame.depth, frame.intrinsics, hand, options)
     assert result.target is not None and result.target.in_view
+
+
+def test_plan_any_refuses_what_it_cannot_choose_among(clutter_frame):
+    hand = cg.load_hand("five-finger-linear")
+    rgb_only = cg.load_planner("default").options
+    rgb_only = replace(rgb_only, perception=replace(rgb_only.perception, segment="rgb"))
+    with pytest.raises(cg.InputError, match="plan_any chooses among the depth candidates: not with segment='rgb'"):
+        pipeline.plan_any(*clutter_frame, hand, rgb_only)

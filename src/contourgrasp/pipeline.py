@@ -474,7 +474,8 @@ def plan_any(rgb, depth, intrinsics: Intrinsics, hand: Hand, options: PlanOption
     Our reading of "grasp something" (a bin, a table to clear): first the object :func:`plan_frame` chooses
     itself, unless a grasp already failed in this scene (``memory`` has an object); then, or when that
     object has no feasible grasp, each other of :func:`objects_to_try` in turn -- those with the fewest failed
-    grasps first -- planned at the pixel deepest inside it, until one has a plan. The result's ``target``
+    grasps first, at most ``tolerances.MAX_OBJECTS_TRIED`` -- planned at the pixel deepest inside it, until one
+    has a plan. The result's ``target``
     and ``seen`` say which object it is on. The parameters are :func:`plan_frame`'s; ``memory`` a
     :class:`~contourgrasp.synthesis.SceneMemory` (each object planned with its own failures).
 
@@ -487,6 +488,8 @@ def plan_any(rgb, depth, intrinsics: Intrinsics, hand: Hand, options: PlanOption
     """
     if memory is not None and not isinstance(memory, SceneMemory):
         raise PlannerError(f"plan_any's memory must be a SceneMemory, got {type(memory).__name__}")
+    if options.perception.segment == "rgb":
+        raise PerceptionError("plan_any chooses among the depth candidates: not with segment='rgb'")
     frame = dict(T_base_camera=T_base_camera, colour_intrinsics=colour_intrinsics, memory=memory)
     reason, tried = None, 0
     if memory is None or not memory.objects:
@@ -498,9 +501,8 @@ def plan_any(rgb, depth, intrinsics: Intrinsics, hand: Hand, options: PlanOption
     found = find_objects(depth, intrinsics, rgb=_on_depth_grid(rgb, np.shape(depth)[:2], intrinsics, colour_intrinsics),
                          fill_holes=perceive.fill_holes, colour_offset_px=perceive.colour_offset_px)
     own = perception.choose_target(found.candidates, max_width=perception.hand_opening(hand))[0] if tried else None
-    for candidate in objects_to_try(found.candidates, hand, memory):
-        if own is not None and candidate.label == own.label:  # planned on already, the first time
-            continue
+    others = [c for c in found.candidates if own is None or c.label != own.label]  # not the one planned on already
+    for candidate in objects_to_try(others, hand, memory):
         tried += 1
         try:
             return plan_frame(rgb, depth, intrinsics, hand, options, target_px=perception.deepest_pixel(candidate.mask),
@@ -509,6 +511,8 @@ def plan_any(rgb, depth, intrinsics: Intrinsics, hand: Hand, options: PlanOption
             reason = getattr(err, "reason", str(err))
     if reason is None:
         raise NoFeasibleGrasp("no object standing wholly in view is narrow enough for the hand to span")
+    if tried == 1:
+        raise NoFeasibleGrasp(reason)
     raise NoFeasibleGrasp(f"none of the {tried} objects tried has a feasible grasp; the last: {reason}")
 
 
