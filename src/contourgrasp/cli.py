@@ -24,6 +24,7 @@ from .io.contour_file import example_contour, example_names, read_contour
 from .io.hand_file import load_hand, preset_names
 from .io.planner_file import load_planner, planner_names
 from .io.plan_file import atomic_outputs, plan_to_dict, write_json
+from .tolerances import MAX_OBJECTS_TRIED
 from .validation import shown, with_options
 
 EXIT_OK, EXIT_INPUT, EXIT_INFEASIBLE = 0, 2, 3
@@ -158,7 +159,8 @@ def _parser() -> argparse.ArgumentParser:
                         help="plan on the wholly visible object with most pixels in this box")
     target.add_argument("--any", action="store_true",
                         help="plan on the object it chooses, or when that has no feasible grasp on the next wholly "
-                             "visible object the hand spans, until one plans (at most 6 more; a bin, a table to clear)")
+                             f"visible object the hand spans, until one plans (at most {MAX_OBJECTS_TRIED} more; a bin, "
+                             "a table to clear)")
     target.add_argument("--all", action="store_true",
                         help="plan every wholly visible object: --out PLAN.json writes PLAN_<label>.json per "
                              "object planned (--plot PLAN.png: PLAN_<label>.png), all or none; without --out the "
