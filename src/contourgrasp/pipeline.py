@@ -475,9 +475,9 @@ def plan_any(rgb, depth, intrinsics: Intrinsics, hand: Hand, options: PlanOption
     itself, unless a grasp already failed in this scene (``memory`` has an object); then, or when that
     object has no feasible grasp, each other of :func:`objects_to_try` in turn -- those with the fewest failed
     grasps first, at most ``tolerances.MAX_OBJECTS_TRIED`` -- planned at the pixel deepest inside it, until one
-    has a plan. The result's ``target``
-    and ``seen`` say which object it is on. The parameters are :func:`plan_frame`'s; ``memory`` a
-    :class:`~contourgrasp.synthesis.SceneMemory` (each object planned with its own failures).
+    has a plan. The result's ``target`` and ``seen`` say which object it is on. The parameters are
+    :func:`plan_frame`'s; ``memory`` a :class:`~contourgrasp.synthesis.SceneMemory` (each object planned with its
+    own failures).
 
     Raises
     ------
@@ -500,7 +500,7 @@ def plan_any(rgb, depth, intrinsics: Intrinsics, hand: Hand, options: PlanOption
     perceive = options.perception
     found = find_objects(depth, intrinsics, rgb=_on_depth_grid(rgb, np.shape(depth)[:2], intrinsics, colour_intrinsics),
                          fill_holes=perceive.fill_holes, colour_offset_px=perceive.colour_offset_px)
-    own = perception.choose_target(found.candidates, max_width=perception.hand_opening(hand))[0] if tried else None
+    own = _own_choice(found.candidates, hand) if tried else None
     others = [c for c in found.candidates if own is None or c.label != own.label]  # not the one planned on already
     for candidate in objects_to_try(others, hand, memory):
         tried += 1
@@ -516,8 +516,17 @@ def plan_any(rgb, depth, intrinsics: Intrinsics, hand: Hand, options: PlanOption
     raise NoFeasibleGrasp(f"none of the {tried} objects tried has a feasible grasp; the last: {reason}")
 
 
+def _own_choice(candidates, hand: Hand) -> perception.Candidate | None:
+    """The candidate :func:`plan_frame` chooses by itself (the ``"hand"`` rule); None where it chose none of them."""
+    try:
+        return perception.choose_target(candidates, max_width=perception.hand_opening(hand))[0]
+    except SegmentationError:
+        return None
+
+
 def _on_depth_grid(rgb, shape, intrinsics: Intrinsics, colour_intrinsics: Intrinsics | None):
-    """``rgb`` on the depth image's grid of ``shape`` (:func:`contourgrasp.perception.colour_on_depth`); None stays None."""
+    """``rgb`` on the depth image's grid of ``shape`` (:func:`contourgrasp.perception.colour_on_depth`); None
+    stays None."""
     if rgb is None:
         return None
     return perception.colour_on_depth(rgb, shape, intrinsics=None if colour_intrinsics is None else intrinsics,
