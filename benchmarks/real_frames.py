@@ -26,7 +26,7 @@ Usage::
 
     python benchmarks/real_frames.py [--data PATH] [--runs 3] [--clock cpu|wall] [--any]
 
-``--any`` plans with :func:`contourgrasp.pipeline.plan_any` (``plan --any``): where the object chosen has no
+``--any`` plans with :func:`contourgrasp.picking.plan_any` (``plan --any``): where the object chosen has no
 feasible grasp, the next one.
 
 ``--data`` defaults to ``$CONTOURGRASP_SHARED_DATA`` or ``../shared/data`` beside the repository.
@@ -54,7 +54,8 @@ import numpy as np  # noqa: E402
 from contourgrasp import load_hand, load_planner, perception  # noqa: E402
 from contourgrasp.errors import ContourGraspError, NoFeasibleGrasp  # noqa: E402
 from contourgrasp.io.camera_file import frame_files, read_rgbd  # noqa: E402
-from contourgrasp.pipeline import plan_any, plan_frame  # noqa: E402
+from contourgrasp.picking import plan_any  # noqa: E402
+from contourgrasp.pipeline import plan_frame  # noqa: E402
 
 SHARED_DATA = Path(os.environ.get("CONTOURGRASP_SHARED_DATA", Path(__file__).resolve().parents[2] / "shared" / "data"))
 #: A target is one object when at least this share of its pixels lies on one label.

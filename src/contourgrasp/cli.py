@@ -470,7 +470,8 @@ def _read_frame(args):
 def _plan(args) -> int:
     from .io.camera_file import read_extrinsics
     from .io.plan_file import image_plan_to_dict
-    from .pipeline import plan_any, plan_frame
+    from .picking import plan_any
+    from .pipeline import plan_frame
 
     frame = _bag_frame(args) if args.bag else _read_frame(args)
     if frame.depth is None:

@@ -49,7 +49,8 @@ from ..hand import Hand
 from ..io.hand_file import load_hand
 from ..io.plan_file import image_plan_to_dict
 from ..io.planner_file import Planner, load_planner
-from ..pipeline import PlanOptions, approaches_supported, plan_any, plan_frame
+from ..picking import plan_any
+from ..pipeline import PlanOptions, approaches_supported, plan_frame
 from ..synthesis import SceneMemory
 from ..threads import one_blas_thread
 from ..validation import with_options
@@ -93,7 +94,7 @@ NO_TARGET = (-1, -1)
 class Settings:
     """The node's validated parameters: the hand, the planner, the options planned with (the planner's, with the
     node's parameters put in), the target pixel (None: the default rule) and whether, without one, the next object
-    is planned where the one chosen has no feasible grasp (:func:`~contourgrasp.pipeline.plan_any`)."""
+    is planned where the one chosen has no feasible grasp (:func:`~contourgrasp.picking.plan_any`)."""
 
     hand: Hand
     planner: Planner

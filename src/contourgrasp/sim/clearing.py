@@ -8,9 +8,9 @@ failed, at most :data:`ATTEMPTS_PER_OBJECT` attempts per object in the scene. Ea
 2. the planner chooses the object itself, as a user's camera frame with no click does (the
    perception's ``"hand"`` rule). After a grasp failed, and whenever the planner's own choice has no
    plan, it is asked about every object standing wholly in view that the hand spans (its minimum-area
-   rectangle no wider than the hand opens: :func:`~contourgrasp.pipeline.objects_to_try`, at most
+   rectangle no wider than the hand opens: :func:`~contourgrasp.picking.objects_to_try`, at most
    ``tolerances.MAX_OBJECTS_TRIED``, each at the pixel deepest inside it), those no grasp failed on first,
-   then those with the fewest failures, until one has a plan (the order :func:`~contourgrasp.pipeline.plan_any`
+   then those with the fewest failures, until one has a plan (the order :func:`~contourgrasp.picking.plan_any`
    tries them in); each object is planned with the memory of the grasps that failed on it
    (:class:`~contourgrasp.synthesis.SceneMemory`: an object is the one a failure was on when it stands within
    ``tolerances.MEMORY_SAME_OBJECT_PX`` of where that failure's object stood).
@@ -48,6 +48,7 @@ import warnings
 import numpy as np
 
 from .. import pipeline
+from ..picking import objects_to_try
 from ..perception import deepest_pixel
 from ..errors import ContourGraspWarning, InputError, NoFeasibleGrasp, SimulationError
 from ..hand import Hand
@@ -162,7 +163,7 @@ def _plan_next(planner, rgb, depth, intrinsics, memory: SceneMemory):
             candidates = pipeline.find_objects(depth, intrinsics, rgb=rgb).candidates
         except InputError as err:
             return None, str(err), time.perf_counter() - started
-        for candidate in pipeline.objects_to_try(candidates, planner.hand, memory):
+        for candidate in objects_to_try(candidates, planner.hand, memory):
             try:
                 planned = planner.plan(rgb, depth, intrinsics, memory=memory.of(candidate.mask),
                                        target_px=deepest_pixel(candidate.mask))
