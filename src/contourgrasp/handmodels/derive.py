@@ -180,7 +180,8 @@ def _bundled(folder: str, xml: str, fingers, **options) -> ModelSpec:
     return ModelSpec(path=str(path), fingertips=tuple(f"{f}_tip" for f in fingers), **options)
 
 
-_INSPIRE_FINGERS = ("thumb", "index", "middle", "ring", "pinky")
+#: The five-finger models' fingertip sites (``<finger>_tip``) and drives are named after these.
+_FIVE_FINGERS = ("thumb", "index", "middle", "ring", "pinky")
 #: The five-finger models' fingers by the names of our hand's.
 _FIVE_FINGER_NAMES = ("thumb", "index", "middle", "ring", "little")
 
@@ -199,16 +200,16 @@ _FIVE_FINGER_NAMES = ("thumb", "index", "middle", "ring", "little")
 #: trials (docs/studies.md, "The MPL model").
 MODELS = {
     "inspire": _bundled(
-        "inspire", "inspire_right_hand.xml", _INSPIRE_FINGERS, palm="r_palm",
+        "inspire", "inspire_right_hand.xml", _FIVE_FINGERS, palm="r_palm",
         names=_FIVE_FINGER_NAMES,
-        actuators=tuple(f"{f}_{j}_drive" for f in _INSPIRE_FINGERS[1:] for j in ("proximal", "distal"))
+        actuators=tuple(f"{f}_{j}_drive" for f in _FIVE_FINGERS[1:] for j in ("proximal", "distal"))
         + ("thumb_proximal_2_drive", "thumb_middle_drive", "thumb_distal_drive"),
         hold=(("thumb_proximal_1_drive", 1.0),), approach=LEVEL, tips_brush_table=True, grasp_height_fraction=0.0,
         slice_contour=False),
     "jaco-three-finger": _bundled("jaco_three_finger", "jaco_three_finger_gripper.xml", ("thumb", "index", "pinky"),
                                   palm="right_gripper", names=("thumb", "index", "pinky"), max_imbalance=1.0),
-    "mpl": _bundled("mpl", "mpl_right.xml", _INSPIRE_FINGERS, palm="palm", names=_FIVE_FINGER_NAMES,
-                    actuators=tuple(f"A_{f}_MCP" for f in _INSPIRE_FINGERS) + ("A_thumb_PIP", "A_thumb_DIP"),
+    "mpl": _bundled("mpl", "mpl_right.xml", _FIVE_FINGERS, palm="palm", names=_FIVE_FINGER_NAMES,
+                    actuators=tuple(f"A_{f}_MCP" for f in _FIVE_FINGERS) + ("A_thumb_PIP", "A_thumb_DIP"),
                     hold=(("A_thumb_ABD", 1.0),), approach=LEVEL, open_from=0.2, max_imbalance=1.0),
 }
 
